@@ -1,0 +1,231 @@
+"""Equilibrium equations and energy of the CoTM, derived with sympy from the geometry."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cache, lru_cache
+
+import numpy as np
+import sympy as sp
+
+from .geometry import PARAM_NAMES, Params
+
+ANGLE_VARS = ("c1", "s1", "c2", "s2")
+
+P = sp.symbols(PARAM_NAMES, real=True)
+PSYM = dict(zip(PARAM_NAMES, P, strict=True))
+
+
+def _cross(a: sp.Matrix, b: sp.Matrix) -> sp.Expr:
+    return a[0] * b[1] - a[1] * b[0]
+
+
+def points(c1, s1, c2, s2) -> dict[int, sp.Matrix]:
+    """Points 1-6 in frame B (eqs. (1)-(4), with the labels of NOTES.md)."""
+    s = PSYM
+    rot = sp.Matrix([[c2, -s2], [s2, c2]])
+    p4 = s["L3"] * sp.Matrix([c1, s1])
+    return {
+        1: sp.Matrix([0, 0]),
+        2: sp.Matrix([s["p2x"], 0]),
+        3: sp.Matrix([s["p3x"], s["p3y"]]),
+        4: p4,
+        5: p4 + rot * sp.Matrix([s["p5x"], s["p5y"]]),
+        6: p4 + rot * sp.Matrix([s["p6x"], 0]),
+    }
+
+
+@dataclass(frozen=True)
+class SymbolicSystem:
+    """Polynomial equations in the solver variables, coefficients symbolic in the parameters."""
+
+    zfl: tuple[bool, bool]
+    variables: tuple[str, ...]
+    names: tuple[str, ...]
+    functions: tuple[sp.Expr, ...]
+
+
+def variables_for(zfl: tuple[bool, bool]) -> tuple[str, ...]:
+    """Solver variables: cos/sin of both angles, plus d_i for each spring with L0i != 0."""
+    return ANGLE_VARS + tuple(f"d{i}" for i in (1, 2) if not zfl[i - 1])
+
+
+@cache
+def derive(zfl: tuple[bool, bool]) -> SymbolicSystem:
+    """Force balance (7), moment balance (8), spring lengths (9)-(10) and unit circles.
+
+    A spring with L0 > 0 pulls with force density k (d - L0) / d; its length d becomes a variable
+    and the balance equations are multiplied through by d (which adds the d = 0 artefacts of
+    NOTES.md). A zero-free-length spring has force density k and needs no d.
+    """
+    names = variables_for(zfl)
+    v = {n: sp.Symbol(n) for n in names}
+    pts = points(v["c1"], v["s1"], v["c2"], v["s2"])
+    spring = {1: pts[6] - pts[2], 2: pts[5] - pts[3]}
+    anchor = {1: pts[2] - pts[1], 2: pts[3] - pts[1]}
+    rod = pts[4] - pts[1]
+    k = {1: PSYM["k1"], 2: PSYM["k2"]}
+    L0 = {1: PSYM["L01"], 2: PSYM["L02"]}
+    d = {i: v.get(f"d{i}") for i in (1, 2)}
+
+    # Force density of spring i, times the d's that clear denominators.
+    density = {}
+    for i, j in ((1, 2), (2, 1)):
+        w = k[i] if zfl[i - 1] else k[i] * (d[i] - L0[i])
+        if not zfl[j - 1]:
+            w = w * d[j]
+        density[i] = w
+
+    force = sum(density[i] * _cross(rod, spring[i]) for i in (1, 2))
+    moment = sum(density[i] * _cross(anchor[i], spring[i]) for i in (1, 2))
+    eqs = [sp.expand(force), sp.expand(moment)]
+    labels = ["force", "moment"]
+    for i in (1, 2):
+        if not zfl[i - 1]:
+            eqs.append(sp.expand(d[i] ** 2 - spring[i].dot(spring[i])))
+            labels.append(f"length{i}")
+    for i in (1, 2):
+        eqs.append(v[f"c{i}"] ** 2 + v[f"s{i}"] ** 2 - 1)
+        labels.append(f"circle{i}")
+    return SymbolicSystem(zfl, names, tuple(labels), tuple(eqs))
+
+
+@dataclass(frozen=True)
+class _CompiledTerms:
+    exponents: tuple[np.ndarray, ...]
+    coeff_fns: tuple  # one callable per function: params -> coefficients
+
+
+@cache
+def _compile(zfl: tuple[bool, bool]) -> _CompiledTerms:
+    sym = derive(zfl)
+    xs = [sp.Symbol(n) for n in sym.variables]
+    exps, fns = [], []
+    for f in sym.functions:
+        poly = sp.Poly(f, *xs)
+        terms = poly.terms()
+        exps.append(np.array([m for m, _ in terms], dtype=np.int64))
+        fns.append(sp.lambdify(P, [c for _, c in terms], "math"))
+    return _CompiledTerms(tuple(exps), tuple(fns))
+
+
+@dataclass(frozen=True)
+class PolySystem:
+    """A square polynomial system with numeric coefficients: one (exponents, coefficients) a row."""
+
+    variables: tuple[str, ...]
+    names: tuple[str, ...]
+    exponents: tuple[np.ndarray, ...]
+    coefficients: tuple[np.ndarray, ...]
+
+    @property
+    def degrees(self) -> tuple[int, ...]:
+        """Total degree of each function."""
+        return tuple(int(e.sum(axis=1).max()) for e in self.exponents)
+
+    @property
+    def total_degree(self) -> int:
+        """Bezout number: the path count of a total-degree homotopy."""
+        return int(np.prod(self.degrees))
+
+    def evaluate(self, x: np.ndarray) -> np.ndarray:
+        """Values of every function at the rows of x, shape (n_points, n_functions)."""
+        x = np.atleast_2d(np.asarray(x, dtype=complex))
+        out = np.empty((x.shape[0], len(self.exponents)), dtype=complex)
+        for i, (e, c) in enumerate(zip(self.exponents, self.coefficients, strict=True)):
+            out[:, i] = np.prod(x[:, None, :] ** e[None, :, :], axis=2) @ c
+        return out
+
+    def jacobian(self, x: np.ndarray) -> np.ndarray:
+        """Jacobian at the rows of x, shape (n_points, n_functions, n_variables)."""
+        x = np.atleast_2d(np.asarray(x, dtype=complex))
+        n, m = x.shape
+        jac = np.zeros((n, len(self.exponents), m), dtype=complex)
+        for i, (e, c) in enumerate(zip(self.exponents, self.coefficients, strict=True)):
+            for j in range(m):
+                ej = e[:, j]
+                mask = ej > 0
+                if not mask.any():
+                    continue
+                de = e[mask].copy()
+                de[:, j] -= 1
+                jac[:, i, j] = np.prod(x[:, None, :] ** de[None, :, :], axis=2) @ (
+                    c[mask] * ej[mask]
+                )
+        return jac
+
+    def scale(self) -> np.ndarray:
+        """Largest coefficient magnitude of each function, to make residuals relative."""
+        return np.array([np.abs(c).max() for c in self.coefficients])
+
+
+def polynomial_system(params: Params) -> PolySystem:
+    """The equations of `derive` with the parameter values substituted."""
+    compiled = _compile(params.zfl)
+    sym = derive(params.zfl)
+    values = [getattr(params, n) for n in PARAM_NAMES]
+    coeffs = tuple(np.array(fn(*values), dtype=float) for fn in compiled.coeff_fns)
+    # Drop terms whose coefficient vanishes for these values (e.g. a zero parameter).
+    exps, cfs = [], []
+    for e, c in zip(compiled.exponents, coeffs, strict=True):
+        keep = c != 0.0
+        exps.append(e[keep])
+        cfs.append(c[keep])
+    return PolySystem(sym.variables, sym.names, tuple(exps), tuple(cfs))
+
+
+# --- energy in the angles -------------------------------------------------------------------
+
+G1, G2 = sp.symbols("gamma1 gamma2", real=True)
+
+
+@lru_cache(maxsize=1)
+def energy_expressions() -> tuple[sp.Expr, list[sp.Expr], sp.Matrix]:
+    """V = sum 1/2 k_i (d_i - L0i)^2 with d_i = |P_spring|, with its gradient and Hessian."""
+    pts = points(sp.cos(G1), sp.sin(G1), sp.cos(G2), sp.sin(G2))
+    q1 = (pts[6] - pts[2]).dot(pts[6] - pts[2])
+    q2 = (pts[5] - pts[3]).dot(pts[5] - pts[3])
+    s = PSYM
+    V = (s["k1"] * (sp.sqrt(q1) - s["L01"]) ** 2 + s["k2"] * (sp.sqrt(q2) - s["L02"]) ** 2) / 2
+    grad = [sp.diff(V, g) for g in (G1, G2)]
+    hess = sp.hessian(V, (G1, G2))
+    return V, grad, hess
+
+
+@lru_cache(maxsize=1)
+def _energy_fns():
+    V, grad, hess = energy_expressions()
+    args = (G1, G2, *P)
+    return (
+        sp.lambdify(args, V, "numpy"),
+        sp.lambdify(args, grad, "numpy"),
+        sp.lambdify(args, hess, "numpy"),
+    )
+
+
+def _broadcast(value, n: int) -> np.ndarray:
+    return np.broadcast_to(np.asarray(value, dtype=float), (n,))
+
+
+def energy(params: Params, g1: np.ndarray, g2: np.ndarray) -> np.ndarray:
+    """Potential energy at angles (radians)."""
+    g1, g2 = np.broadcast_arrays(np.asarray(g1, float), np.asarray(g2, float))
+    fn = _energy_fns()[0]
+    return _broadcast(fn(g1, g2, *params.as_dict().values()), g1.size).reshape(g1.shape)
+
+
+def energy_gradient(params: Params, g1: np.ndarray, g2: np.ndarray) -> np.ndarray:
+    """Gradient of V, shape (..., 2)."""
+    g1, g2 = np.broadcast_arrays(np.atleast_1d(np.asarray(g1, float)), np.atleast_1d(g2))
+    fn = _energy_fns()[1]
+    vals = fn(g1, g2, *params.as_dict().values())
+    return np.stack([_broadcast(v, g1.size).reshape(g1.shape) for v in vals], axis=-1)
+
+
+def energy_hessian(params: Params, g1: np.ndarray, g2: np.ndarray) -> np.ndarray:
+    """Hessian of V, shape (..., 2, 2)."""
+    g1, g2 = np.broadcast_arrays(np.atleast_1d(np.asarray(g1, float)), np.atleast_1d(g2))
+    fn = _energy_fns()[2]
+    vals = fn(g1, g2, *params.as_dict().values())
+    flat = [_broadcast(v, g1.size).reshape(g1.shape) for row in vals for v in row]
+    return np.stack(flat, axis=-1).reshape(*g1.shape, 2, 2)

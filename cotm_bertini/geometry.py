@@ -1,0 +1,167 @@
+"""Mechanism parameters: Table 1 of the paper, case presets, validation and loading."""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import asdict, dataclass, fields, replace
+from pathlib import Path
+
+PARAM_NAMES = ("L3", "k1", "k2", "p2x", "p3x", "p3y", "p6x", "p5x", "p5y", "L01", "L02")
+
+PARAM_UNITS = {
+    "L3": "m",
+    "k1": "N/m",
+    "k2": "N/m",
+    "p2x": "m",
+    "p3x": "m",
+    "p3y": "m",
+    "p6x": "m",
+    "p5x": "m",
+    "p5y": "m",
+    "L01": "m",
+    "L02": "m",
+}
+
+# Table 1 of DETC2018-85998. Points follow NOTES.md: in frame B, P2 = [p2x, 0], P3 = [p3x, p3y];
+# in frame T, P6 = [p6x, 0], P5 = [p5x, p5y] (eq. (2) of the paper swaps the labels).
+TABLE1 = {
+    "L3": 9.0,
+    "k1": 2.81,
+    "k2": 2.81,
+    "p2x": 3.1875,
+    "p3x": -2.5745,
+    "p3y": 4.9309,
+    "p6x": 4.25,
+    "p5x": -0.299,
+    "p5y": -3.4872,
+    "L01": 0.0,
+    "L02": 0.0,
+}
+
+CASES = {
+    "case1": {"L01": 0.0, "L02": 0.0},
+    "case2": {"L01": 11.5, "L02": 0.0},
+    "case3": {"L01": 11.5, "L02": 11.5},
+}
+
+# Two points of one body closer than this (relative to L3) are "coincident".
+_COINCIDENT_REL = 1e-9
+
+
+class ParameterError(ValueError):
+    """A parameter value or name that cannot describe a mechanism; the message is one line."""
+
+
+@dataclass(frozen=True)
+class Params:
+    """Geometry, stiffness and free lengths of the CoTM (metres, N/m)."""
+
+    L3: float
+    k1: float
+    k2: float
+    p2x: float
+    p3x: float
+    p3y: float
+    p6x: float
+    p5x: float
+    p5y: float
+    L01: float
+    L02: float
+
+    def __post_init__(self) -> None:
+        validate(self)
+
+    @property
+    def zfl(self) -> tuple[bool, bool]:
+        """Whether spring 1 and spring 2 have zero free length."""
+        return (self.L01 == 0.0, self.L02 == 0.0)
+
+    def as_dict(self) -> dict[str, float]:
+        """Parameters as a plain dict, in PARAM_NAMES order."""
+        return asdict(self)
+
+    def with_values(self, **values: float) -> Params:
+        """A copy with some values replaced (validated)."""
+        return replace(self, **values)
+
+
+def validate(p: Params) -> None:
+    """Raise ParameterError naming the first field whose value cannot describe a mechanism."""
+    for f in fields(p):
+        v = getattr(p, f.name)
+        if isinstance(v, bool) or not isinstance(v, int | float):
+            raise ParameterError(f"{f.name} = {v!r}: must be a number")
+        if not math.isfinite(v):
+            raise ParameterError(f"{f.name} = {v!r}: must be finite")
+    if p.L3 <= 0:
+        raise ParameterError(f"L3 = {p.L3!r}: the rod length must be > 0")
+    for name in ("k1", "k2"):
+        if getattr(p, name) <= 0:
+            raise ParameterError(f"{name} = {getattr(p, name)!r}: a spring constant must be > 0")
+    for name in ("L01", "L02"):
+        if getattr(p, name) < 0:
+            raise ParameterError(f"{name} = {getattr(p, name)!r}: a free length must be >= 0")
+    tol = _COINCIDENT_REL * p.L3
+    if abs(p.p2x) <= tol:
+        raise ParameterError(f"p2x = {p.p2x!r}: point 2 coincides with point 1")
+    if math.hypot(p.p3x, p.p3y) <= tol:
+        raise ParameterError(f"p3x, p3y = {p.p3x!r}, {p.p3y!r}: point 3 coincides with point 1")
+    if math.hypot(p.p3x - p.p2x, p.p3y) <= tol:
+        raise ParameterError(f"p3x, p3y = {p.p3x!r}, {p.p3y!r}: point 3 coincides with point 2")
+    if abs(p.p6x) <= tol:
+        raise ParameterError(f"p6x = {p.p6x!r}: point 6 coincides with point 4")
+    if math.hypot(p.p5x, p.p5y) <= tol:
+        raise ParameterError(f"p5x, p5y = {p.p5x!r}, {p.p5y!r}: point 5 coincides with point 4")
+    if math.hypot(p.p5x - p.p6x, p.p5y) <= tol:
+        raise ParameterError(f"p5x, p5y = {p.p5x!r}, {p.p5y!r}: point 5 coincides with point 6")
+
+
+def _coerce(name: str, value: object) -> float:
+    if name not in PARAM_NAMES:
+        raise ParameterError(f"{name}: unknown parameter (known: {' '.join(PARAM_NAMES)})")
+    if isinstance(value, bool) or not isinstance(value, int | float | str):
+        raise ParameterError(f"{name} = {value!r}: must be a number")
+    try:
+        return float(value)
+    except ValueError:
+        raise ParameterError(f"{name} = {value!r}: must be a number") from None
+
+
+def parse_assignment(text: str) -> tuple[str, float]:
+    """Parse one `NAME=VALUE` command-line assignment."""
+    name, sep, value = text.partition("=")
+    name = name.strip()
+    if not sep:
+        raise ParameterError(f"--set {text!r}: expected NAME=VALUE")
+    return name, _coerce(name, value.strip())
+
+
+def load_toml(path: str | Path) -> dict[str, float]:
+    """Read a TOML file of top-level parameter values (any subset of PARAM_NAMES)."""
+    path = Path(path)
+    try:
+        with path.open("rb") as fh:
+            data = tomllib.load(fh)
+    except FileNotFoundError:
+        raise ParameterError(f"--params {str(path)!r}: file not found") from None
+    except IsADirectoryError:
+        raise ParameterError(f"--params {str(path)!r}: is a directory, not a file") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ParameterError(f"--params {str(path)!r}: not valid TOML ({exc})") from None
+    return {name: _coerce(name, value) for name, value in data.items()}
+
+
+def make_params(
+    case: str | None = None,
+    overrides: dict[str, float] | None = None,
+) -> Params:
+    """Table 1, then the case preset (L01/L02), then user overrides, validated."""
+    values = dict(TABLE1)
+    if case is not None:
+        if case not in CASES:
+            raise ParameterError(f"case = {case!r}: expected one of {', '.join(CASES)}")
+        values.update(CASES[case])
+    for name, value in (overrides or {}).items():
+        values[name] = _coerce(name, value)
+    return Params(**values)

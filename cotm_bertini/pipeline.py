@@ -1,0 +1,186 @@
+"""One solve end to end: equations -> input file -> Bertini -> tables -> classified solutions."""
+
+from __future__ import annotations
+
+import datetime as dt
+import secrets
+import tempfile
+import time
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pandas as pd
+
+from . import engine as engine_mod
+from .equations import PolySystem, polynomial_system
+from .geometry import Params
+from .parse import BertiniOutput, read_output
+from .render import render_input
+from .results import write_csv, write_json
+from .settings import Settings
+from .solver import run_bertini
+from .stability import Tolerances, classify
+
+
+@dataclass
+class Timings:
+    """Wall-clock seconds per stage."""
+
+    stages: dict[str, float] = field(default_factory=dict)
+
+    @contextmanager
+    def stage(self, name: str):
+        start = time.perf_counter()
+        try:
+            yield
+        finally:
+            self.stages[name] = self.stages.get(name, 0.0) + time.perf_counter() - start
+
+
+@dataclass(frozen=True)
+class Solved:
+    """The solutions of one run and what produced them."""
+
+    solutions: pd.DataFrame
+    system: PolySystem
+    output: BertiniOutput
+    input_text: str
+    engine: engine_mod.Engine
+    bertini_version: str
+    bertini_seconds: float
+    paths_tracked: int | None
+    timings: dict[str, float]
+
+
+def solve_in(
+    folder: Path,
+    params: Params,
+    settings: Settings,
+    tolerances: Tolerances = Tolerances(),
+    title: str = "",
+) -> Solved:
+    """Solve `params` with Bertini in the empty `folder` (kept with Bertini's files)."""
+    t = Timings()
+    with t.stage("derive"):
+        system = polynomial_system(params)
+    with t.stage("render"):
+        text = render_input(system, settings, params.as_dict(), title)
+    eng = engine_mod.find_engine(settings.bertini)
+    with t.stage("solve"):
+        run = run_bertini(text, folder, eng, settings.timeout, settings.threads)
+    with t.stage("parse"):
+        out = read_output(folder)
+    with t.stage("classify"):
+        table = classify(params, system, out.endpoints, out.variables, tolerances)
+    tracked = run.paths_tracked
+    if tracked is None and settings.variable_groups == "total_degree":
+        tracked = system.total_degree
+    return Solved(table, system, out, text, eng, run.version, run.seconds, tracked, t.stages)
+
+
+def solve(
+    params: Params, settings: Settings = Settings(), tolerances: Tolerances = Tolerances()
+) -> pd.DataFrame:
+    """Every finite solution of `params`, classified; Bertini runs in a throw-away folder."""
+    with tempfile.TemporaryDirectory(prefix="cotm-") as tmp:
+        return solve_in(Path(tmp) / "run", params, settings, tolerances).solutions
+
+
+def summary_counts(solved: Solved) -> dict[str, int]:
+    """Path and solution counts for run.json and the console."""
+    s = solved.solutions
+    tracked = solved.paths_tracked
+    return {
+        "paths_tracked": tracked,
+        "finite_endpoints": len(solved.output.endpoints),
+        "nonfinite_or_failed_paths": None
+        if tracked is None
+        else tracked - len(solved.output.endpoints),
+        "bertini1_failed_paths_file": solved.output.failed_paths,
+        "distinct_solutions": len(s),
+        "real": int(s["is_real"].sum()),
+        "physical": int(s["physical"].sum()),
+        "stable": int(s["stable"].sum()),
+        "zero_length_artefacts": int((s["reason"] == "zero_length_spring").sum()),
+        "negative_d": int((s["reason"] == "negative_d").sum()),
+        "singular": int(s["singular"].sum()),
+    }
+
+
+def new_run_folder(root: Path) -> tuple[Path, Path]:
+    """A (working, final) pair of folder names under root; work happens in a hidden folder."""
+    stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
+    name = f"{stamp}-{secrets.token_hex(3)}"
+    root.mkdir(parents=True, exist_ok=True)
+    return root / f".partial-{name}", root / name
+
+
+def run_and_record(
+    params: Params,
+    settings: Settings,
+    root: Path,
+    label: str,
+    command: list[str] | None = None,
+    tolerances: Tolerances = Tolerances(),
+) -> tuple[Path, Solved | None, dict]:
+    """Solve into a new run folder under root with solutions.csv and run.json.
+
+    The folder is built under a hidden name and renamed when complete; a failed run is renamed
+    to `<name>-failed` with run.json saying why, so nothing is half-written or silently lost.
+    """
+    work, final = new_run_folder(root)
+    work.mkdir()
+    record: dict = {
+        "label": label,
+        "created": dt.datetime.now().astimezone().isoformat(timespec="seconds"),
+        "command": command,
+        "parameters": params.as_dict(),
+        "zero_free_length": {"spring1": params.zfl[0], "spring2": params.zfl[1]},
+        "settings": settings.as_dict(),
+        "seed": settings.seed,
+        "tolerances": tolerances.__dict__,
+        "versions": engine_mod.python_versions(),
+    }
+    start = time.perf_counter()
+    try:
+        solved = solve_in(work, params, settings, tolerances, title=label)
+    except BaseException as exc:  # whatever stopped the run, the folder says so
+        record.update(
+            status="failed",
+            error=f"{type(exc).__name__}: {exc}",
+            timings={"total": time.perf_counter() - start},
+        )
+        write_json(work / "run.json", record)
+        work.rename(final.with_name(final.name + "-failed"))
+        raise
+    t_write = time.perf_counter()
+    write_csv(work / "solutions.csv", solved.solutions)
+    timings = dict(solved.timings)
+    timings["write"] = time.perf_counter() - t_write
+    timings["total"] = time.perf_counter() - start
+    record.update(
+        status="ok",
+        engine={
+            "flavour": solved.engine.flavour,
+            "path": solved.engine.path,
+            "version": solved.bertini_version,
+        },
+        output_layout=solved.output.layout,
+        polynomial_system={
+            "variables": list(solved.system.variables),
+            "functions": list(solved.system.names),
+            "degrees": list(solved.system.degrees),
+            "total_degree": solved.system.total_degree,
+        },
+        counts=summary_counts(solved),
+        timings=timings,
+    )
+    write_json(work / "run.json", record)
+    work.rename(final)
+    latest = root / "latest"
+    if latest.is_symlink() or not latest.exists():
+        tmp_link = root / f".latest-{final.name}"
+        tmp_link.symlink_to(final.name)
+        tmp_link.replace(latest)
+    return final, solved, record

@@ -1,0 +1,273 @@
+"""Turn solver endpoints into solutions: merge, refine, and classify real, physical, stable."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from .equations import PolySystem, energy, energy_hessian
+from .geometry import Params
+
+
+@dataclass(frozen=True)
+class Tolerances:
+    """Thresholds of the classification; each is documented in the README."""
+
+    imag: float = 1e-8  # |Im| of every variable below this (relative to 1 + |x|): real
+    singular_condition: float = 1e8  # condition number above this: a singular endpoint
+    zero_length: float = 1e-5  # |d| below this times L3 at a singular endpoint: d = 0 artefact
+    merge: float = 1e-8  # nonsingular endpoints closer than this (relative) are one solution
+    hessian: float = 1e-9  # eigenvalues within this (relative to k L3^2) of 0: degenerate
+    newton_steps: int = 3
+
+
+def newton_refine(system: PolySystem, x: np.ndarray, steps: int) -> tuple[np.ndarray, np.ndarray]:
+    """A few complex Newton steps, each kept only where it lowers the residual."""
+    x = np.array(x, dtype=complex)
+    scale = system.scale()
+    res = np.abs(system.evaluate(x) / scale).max(axis=1)
+    for _ in range(steps):
+        f = system.evaluate(x)
+        jac = system.jacobian(x)
+        step = np.zeros_like(x)
+        ok = np.isfinite(jac).all(axis=(1, 2)) & (np.linalg.cond(jac) < 1e14)
+        if ok.any():
+            step[ok] = np.linalg.solve(jac[ok], f[ok][..., None])[..., 0]
+        trial = x - step
+        new = np.abs(system.evaluate(trial) / scale).max(axis=1)
+        better = ok & (new < res)
+        x[better] = trial[better]
+        res[better] = new[better]
+    return x, res
+
+
+def cluster_endpoints(
+    x: np.ndarray, singular: np.ndarray, accuracy: np.ndarray, tol: float
+) -> np.ndarray:
+    """Label endpoints that are one solution (several paths reaching it) with one group id."""
+    n = len(x)
+    labels = -np.ones(n, dtype=int)
+    mag = 1.0 + np.abs(x).max(axis=1)
+    # A singular root is only known to about the square root of the tracking accuracy.
+    loose = np.where(singular, 10.0 * np.sqrt(np.maximum(accuracy, 1e-16)), tol)
+    group = 0
+    for i in range(n):
+        if labels[i] >= 0:
+            continue
+        labels[i] = group
+        for j in range(i + 1, n):
+            if labels[j] >= 0:
+                continue
+            limit = max(loose[i], loose[j]) if (singular[i] or singular[j]) else tol
+            if np.abs(x[i] - x[j]).max() <= limit * max(mag[i], mag[j]):
+                labels[j] = group
+        group += 1
+    return labels
+
+
+def complex_angles(c: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """gamma = -i log(c + i s), in degrees: real for points on the real circle."""
+    return (-1j * np.log(c + 1j * s)) * (180.0 / np.pi)
+
+
+def spring_vectors(params: Params, g1: np.ndarray, g2: np.ndarray) -> dict[str, np.ndarray]:
+    """Points 2 -> 6 and 3 -> 5 and the rod 1 -> 4, in frame B, for real angles (radians)."""
+    p = params
+    c1, s1, c2, s2 = np.cos(g1), np.sin(g1), np.cos(g2), np.sin(g2)
+    p4 = np.stack([p.L3 * c1, p.L3 * s1], axis=-1)
+    p6 = p4 + np.stack([c2 * p.p6x, s2 * p.p6x], axis=-1)
+    p5 = p4 + np.stack([c2 * p.p5x - s2 * p.p5y, s2 * p.p5x + c2 * p.p5y], axis=-1)
+    return {
+        "spring1": p6 - np.array([p.p2x, 0.0]),
+        "spring2": p5 - np.array([p.p3x, p.p3y]),
+        "rod": p4,
+    }
+
+
+def classify(
+    params: Params,
+    system: PolySystem,
+    endpoints: pd.DataFrame,
+    variables: tuple[str, ...],
+    tol: Tolerances = Tolerances(),
+) -> pd.DataFrame:
+    """One row per distinct finite solution with the solutions.csv columns (see README)."""
+    x0 = endpoints[list(variables)].to_numpy(dtype=complex)
+    cond = endpoints["condition_number"].to_numpy(dtype=float)
+    acc = endpoints["accuracy_estimate"].fillna(0.0).to_numpy(dtype=float)
+    singular = (cond > tol.singular_condition) | (endpoints["bertini_multiplicity"] > 1).to_numpy()
+    x, res = newton_refine(system, x0, 0 if len(x0) == 0 else tol.newton_steps)
+    x[singular] = x0[singular]  # Newton does not converge quadratically there; keep Bertini's
+    labels = cluster_endpoints(x, singular, acc, tol.merge)
+
+    rows = []
+    for g in range(labels.max() + 1 if len(labels) else 0):
+        members = np.flatnonzero(labels == g)
+        best = members[np.argmin(res[members])]
+        rows.append(
+            {
+                "best": best,
+                "multiplicity": len(members),
+                "paths": " ".join(
+                    str(int(p)) for p in endpoints["path_number"].to_numpy()[members]
+                ),
+                "condition_number": float(cond[members].max()),
+                "singular": bool(singular[members].any() or len(members) > 1),
+                "accuracy": float(acc[members].max()),
+            }
+        )
+    if not rows:
+        return _empty_frame(variables)
+    best = np.array([r["best"] for r in rows])
+    pts = x[best]
+    absres = np.abs(system.evaluate(pts)).max(axis=1)
+    v = {name: pts[:, k] for k, name in enumerate(variables)}
+    gam1 = complex_angles(v["c1"], v["s1"])
+    gam2 = complex_angles(v["c2"], v["s2"])
+    max_imag = (np.abs(pts.imag) / (1.0 + np.abs(pts.real))).max(axis=1)
+    sing = np.array([r["singular"] for r in rows])
+    # A singular root is known to about sqrt(accuracy) only: so is its imaginary part.
+    loose = np.minimum(10.0 * np.sqrt([max(r["accuracy"], 1e-16) for r in rows]), 1e-4)
+    is_real = max_imag < np.where(sing, np.maximum(loose, tol.imag), tol.imag)
+
+    g1r, g2r = np.radians(gam1.real), np.radians(gam2.real)
+    vec = spring_vectors(params, g1r, g2r)
+    length = {i: np.hypot(*vec[f"spring{i}"].T) for i in (1, 2)}
+    d = {}
+    for i in (1, 2):
+        name = f"d{i}"
+        d[i] = v[name].real if name in v else length[i]
+    frame = pd.DataFrame(
+        {
+            "solution_id": np.arange(1, len(rows) + 1),
+            "gamma1_deg": np.mod(gam1.real, 360.0),
+            "gamma2_deg": np.mod(gam2.real, 360.0),
+            "gamma1_imag_deg": gam1.imag,
+            "gamma2_imag_deg": gam2.imag,
+            "d1": d[1],
+            "d2": d[2],
+            "is_real": is_real,
+            "max_imag": max_imag,
+        }
+    )
+    zero = np.zeros(len(rows), dtype=bool)
+    for i in (1, 2):
+        if f"d{i}" in v:
+            zero |= sing & (np.abs(v[f"d{i}"]) < tol.zero_length * params.L3)
+    negative = is_real & ((d[1] <= 0) | (d[2] <= 0)) & ~zero
+    frame["reason"] = np.select(
+        [zero, ~is_real, negative], ["zero_length_spring", "complex", "negative_d"], default=""
+    )
+    physical = is_real & ~zero & ~negative
+    frame["physical"] = physical
+    frame["residual"] = absres
+    frame["condition_number"] = [r["condition_number"] for r in rows]
+    frame["multiplicity"] = [r["multiplicity"] for r in rows]
+    frame["singular"] = sing
+
+    _mechanics(frame, params, g1r, g2r, vec, length, physical & ~sing, tol)
+    frame["paths"] = [r["paths"] for r in rows]
+    for name in variables:
+        frame[f"{name}_re"] = v[name].real
+        frame[f"{name}_im"] = v[name].imag
+    return _order(frame)
+
+
+def _mechanics(
+    frame: pd.DataFrame,
+    params: Params,
+    g1: np.ndarray,
+    g2: np.ndarray,
+    vec: dict[str, np.ndarray],
+    length: dict[int, np.ndarray],
+    can_be_stable: np.ndarray,
+    tol: Tolerances,
+) -> None:
+    """Energy, Hessian, kind, forces; NaN where a row is not a physical equilibrium."""
+    phys = frame["physical"].to_numpy()
+    n = len(frame)
+    nan = np.full(n, np.nan)
+    e = nan.copy()
+    lam = np.full((n, 2), np.nan)
+    if phys.any():
+        e[phys] = energy(params, g1[phys], g2[phys])
+        hess = energy_hessian(params, g1[phys], g2[phys])
+        lam[phys] = np.linalg.eigvalsh(hess)
+    scale = max(params.k1, params.k2) * params.L3**2
+    pos = lam > tol.hessian * scale
+    negv = lam < -tol.hessian * scale
+    kind = np.where(
+        ~phys,
+        "",
+        np.where(
+            pos.all(axis=1),
+            "min",
+            np.where(
+                negv.all(axis=1),
+                "max",
+                np.where(pos.any(axis=1) & negv.any(axis=1), "saddle", "degenerate"),
+            ),
+        ),
+    )
+    frame["stable"] = phys & can_be_stable & (kind == "min")
+    frame["kind"] = kind
+    frame["energy"] = e
+    frame["hess_eig1"] = lam[:, 0]
+    frame["hess_eig2"] = lam[:, 1]
+    f = {}
+    for i, (k, L0) in enumerate(((params.k1, params.L01), (params.k2, params.L02)), start=1):
+        f[i] = np.where(phys, k * (length[i] - L0), np.nan)
+        frame[f"spring{i}_force"] = f[i]
+    # Rod force from the force balance f1 u1 + f2 u2 + f3 u_rod = 0 (eq. (5)); tension > 0.
+    with np.errstate(invalid="ignore", divide="ignore"):
+        u_rod = vec["rod"] / params.L3
+        pull = sum(f[i][:, None] * vec[f"spring{i}"] / length[i][:, None] for i in (1, 2))
+        f3 = -(pull * u_rod).sum(axis=1)
+    frame["rod_force"] = np.where(phys, f3, np.nan)
+    frame["tensegrity"] = phys & (f[1] > 0) & (f[2] > 0) & (f3 < 0)
+
+
+COLUMNS = [
+    "solution_id",
+    "gamma1_deg",
+    "gamma2_deg",
+    "d1",
+    "d2",
+    "is_real",
+    "max_imag",
+    "physical",
+    "stable",
+    "residual",
+    "condition_number",
+    "multiplicity",
+    "reason",
+    "singular",
+    "kind",
+    "energy",
+    "hess_eig1",
+    "hess_eig2",
+    "spring1_force",
+    "spring2_force",
+    "rod_force",
+    "tensegrity",
+    "gamma1_imag_deg",
+    "gamma2_imag_deg",
+    "paths",
+]
+
+
+def _order(frame: pd.DataFrame) -> pd.DataFrame:
+    # Physical first, then real, then complex; within each by angle, so ids are stable.
+    key = np.where(frame["physical"], 0, np.where(frame["is_real"], 1, 2))
+    frame = frame.assign(_k=key).sort_values(["_k", "gamma1_deg", "gamma2_deg"], kind="stable")
+    frame = frame.drop(columns="_k").reset_index(drop=True)
+    frame["solution_id"] = np.arange(1, len(frame) + 1)
+    rest = [c for c in frame.columns if c not in COLUMNS]
+    return frame[COLUMNS + rest]
+
+
+def _empty_frame(variables: tuple[str, ...]) -> pd.DataFrame:
+    cols = COLUMNS + [f"{n}_{p}" for n in variables for p in ("re", "im")]
+    return pd.DataFrame({c: pd.Series(dtype=float) for c in cols})

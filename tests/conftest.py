@@ -1,0 +1,34 @@
+"""Shared fixtures: paths, and each case solved once per test session."""
+
+from __future__ import annotations
+
+import sys
+from functools import cache
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+FIXTURES = ROOT.parent / "shared" / "fixtures" / "bertini-1.6"
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+
+@cache
+def solved(case: str, k2: float | None = None):
+    """Solve a case once per session (optionally with another k2) and keep the Solved record."""
+    import tempfile
+
+    from cotm_bertini.geometry import make_params
+    from cotm_bertini.pipeline import solve_in
+    from cotm_bertini.settings import Settings
+
+    params = make_params(case, {} if k2 is None else {"k2": k2})
+    folder = Path(tempfile.mkdtemp(prefix=f"cotm-test-{case}-")) / "run"
+    return solve_in(folder, params, Settings(seed=7)), params
+
+
+@pytest.fixture(scope="session")
+def fixtures_dir() -> Path:
+    if not FIXTURES.is_dir():
+        pytest.fail(f"Bertini 1.6 fixtures not found at {FIXTURES} (shared/ must sit beside main)")
+    return FIXTURES

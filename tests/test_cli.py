@@ -1,0 +1,164 @@
+"""The console script: a real solve, bad input, and solver faults (with stand-in binaries)."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+REQUIRED = [
+    "solution_id",
+    "gamma1_deg",
+    "gamma2_deg",
+    "d1",
+    "d2",
+    "is_real",
+    "max_imag",
+    "physical",
+    "stable",
+    "residual",
+    "condition_number",
+    "multiplicity",
+]
+
+
+def cli(*args: str, env: dict | None = None, cwd: Path | None = None):
+    """Run `cotm-bertini` as a user would, in a fresh process."""
+    return subprocess.run(
+        [sys.executable, "-m", "cotm_bertini.cli", *args],
+        capture_output=True,
+        text=True,
+        env={**os.environ, **(env or {})},
+        cwd=cwd,
+        timeout=300,
+    )
+
+
+def test_solve_case1_writes_run_folder(tmp_path):
+    """solve case1: exit 0, one run folder with solutions.csv, input, Bertini files, run.json."""
+    r = cli("solve", "case1", "--out", str(tmp_path), "--seed", "11")
+    assert r.returncode == 0, r.stderr
+    runs = [p for p in tmp_path.iterdir() if p.is_dir() and not p.is_symlink()]
+    assert len(runs) == 1
+    run = runs[0]
+    assert str(run) in r.stdout
+    for name in ("solutions.csv", "input", "run.json", "main_data", "finite_solutions"):
+        assert (run / name).is_file(), name
+    table = pd.read_csv(run / "solutions.csv")
+    assert list(table.columns[: len(REQUIRED)]) == REQUIRED
+    assert len(table) == 6 and table["is_real"].sum() == 4
+    assert table.loc[table["is_real"], "gamma1_deg"].between(0, 360).all()
+    rec = json.loads((run / "run.json").read_text())
+    assert rec["status"] == "ok"
+    assert rec["seed"] == 11 and "RandomSeed: 11;" in (run / "input").read_text()
+    assert rec["parameters"]["L01"] == 0.0 and rec["parameters"]["L3"] == 9.0
+    for key in ("bertini2", "numpy", "sympy"):
+        assert rec["versions"][key] not in ("", "not installed")
+    for stage in ("derive", "render", "solve", "parse", "classify", "write", "total"):
+        assert rec["timings"][stage] >= 0
+    assert rec["counts"]["distinct_solutions"] == 6
+    assert not list(tmp_path.glob(".partial-*"))
+
+
+def test_params_file_and_set_override(tmp_path):
+    """A TOML subset plus --set: the rest from Table 1, the case preset only sets L01/L02."""
+    toml = tmp_path / "p.toml"
+    toml.write_text("k2 = 3.0\nL3 = 9.5\n")
+    r = cli(
+        "solve",
+        "case2",
+        "--params",
+        str(toml),
+        "--set",
+        "L01=10",
+        "--out",
+        str(tmp_path / "o"),
+        "--quiet",
+    )
+    assert r.returncode == 0, r.stderr
+    rec = json.loads((Path(r.stdout.strip()) / "run.json").read_text())
+    p = rec["parameters"]
+    assert (p["k2"], p["L3"], p["L01"], p["L02"], p["k1"]) == (3.0, 9.5, 10.0, 0.0, 2.81)
+
+
+@pytest.mark.parametrize(
+    ("toml", "sets", "needle"),
+    [
+        ("k1 = -1\n", [], "k1 = -1"),
+        (None, [], "file not found"),
+        ("q7 = 1\n", [], "q7: unknown parameter"),
+        ('L3 = "nine"\n', [], "L3 = 'nine': must be a number"),
+        (None, ["--set", "L01=abc"], "L01 = 'abc': must be a number"),
+        (None, ["--set", "L02=-2"], "L02 = -2.0"),
+        ("L3 = nan\n", [], "L3 = nan: must be finite"),
+        ("p6x = 0\n", [], "p6x = 0.0"),
+        ("k1 = [\n", [], "not valid TOML"),
+    ],
+)
+def test_bad_input_is_one_line_exit_2_and_no_folder(tmp_path, toml, sets, needle):
+    """Bad input: one clear line naming field and value, exit code 2, no run folder at all."""
+    args = ["solve", "case1", "--out", str(tmp_path / "out")]
+    if toml is not None:
+        (tmp_path / "p.toml").write_text(toml)
+        args += ["--params", str(tmp_path / "p.toml")]
+    elif not sets:
+        args += ["--params", str(tmp_path / "missing.toml")]
+    r = cli(*args, *sets)
+    assert r.returncode == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1, r.stderr
+    assert needle in lines[0]
+    assert not (tmp_path / "out").exists()
+
+
+def _fake_bertini(tmp_path: Path, body: str) -> Path:
+    exe = tmp_path / "fake-bertini"
+    exe.write_text("#!/bin/sh\n" + body + "\n")
+    exe.chmod(0o755)
+    return exe
+
+
+@pytest.mark.parametrize(
+    ("body", "needle"),
+    [
+        ('echo "ERROR: could not parse function f0" >&2; exit 1', "could not parse function f0"),
+        ("sleep 30", "timed out after 1 s"),
+        ('echo "finished"', "wrote no main_data"),
+    ],
+)
+def test_solver_faults_are_reported_and_recorded(tmp_path, body, needle):
+    """A crash, a timeout, missing output: exit 3, Bertini's words quoted, a -failed folder."""
+    exe = _fake_bertini(tmp_path, body)
+    r = cli("solve", "case1", "--bertini", str(exe), "--timeout", "1", "--out", str(tmp_path / "o"))
+    assert r.returncode == 3
+    assert needle in r.stderr
+    failed = list((tmp_path / "o").glob("*-failed"))
+    assert len(failed) == 1
+    rec = json.loads((failed[0] / "run.json").read_text())
+    assert rec["status"] == "failed" and needle in rec["error"]
+    assert not list((tmp_path / "o").glob(".partial-*"))
+
+
+@pytest.mark.parametrize("case", ["case1", "case2", "case3"])
+def test_user_bertini1_binary(tmp_path, fixtures_dir, case):
+    """COTM_BERTINI: a Bertini 1.x binary (replaying the real 1.6 files) runs the pipeline."""
+    src = fixtures_dir / case
+    exe = _fake_bertini(
+        tmp_path,
+        f'for f in {src}/*; do n=$(basename "$f"); [ "$n" = input ] || cp "$f" .; done\n'
+        f"chmod u+w *; cat {src}/stdout.txt",
+    )
+    r = cli("solve", case, "--out", str(tmp_path / "o"), "--quiet", env={"COTM_BERTINI": str(exe)})
+    assert r.returncode == 0, r.stderr
+    run = Path(r.stdout.strip())
+    rec = json.loads((run / "run.json").read_text())
+    assert rec["engine"]["flavour"] == "bertini1" and rec["engine"]["version"] == "1.6"
+    assert rec["output_layout"] == "bertini1"
+    expected = {"case1": (8, 6, 4), "case2": (48, 22, 10), "case3": (192, 76, 30)}[case]
+    c = rec["counts"]
+    assert (c["paths_tracked"], c["distinct_solutions"], c["real"]) == expected

@@ -1,0 +1,74 @@
+"""Parsing Bertini 1.6 (labelled) and Bertini 2 (unlabelled) output into one table shape."""
+
+from __future__ import annotations
+
+import shutil
+
+import numpy as np
+import pytest
+
+from cotm_bertini.engine import find_engine
+from cotm_bertini.equations import polynomial_system
+from cotm_bertini.geometry import make_params
+from cotm_bertini.parse import ParseError, read_output, read_solution_list
+from cotm_bertini.solver import run_bertini
+from cotm_bertini.stability import classify
+
+# Bertini 1.6 stdout summaries (fixtures/README.md): finite endpoints and distinct solutions.
+EXPECTED = {"case1": (6, 6, 4), "case2": (24, 22, 10), "case3": (84, 76, 30)}
+
+
+@pytest.mark.parametrize("case", ["case1", "case2", "case3"])
+def test_bertini16_fixtures(fixtures_dir, case):
+    """Bertini 1.6 main_data: a row per finite endpoint, duplicates expanded, counts as printed."""
+    out = read_output(fixtures_dir / case)
+    endpoints, distinct, real = EXPECTED[case]
+    assert out.layout == "bertini1"
+    assert len(out.endpoints) == endpoints == out.finite_solutions_count
+    assert out.endpoints["path_number"].is_unique
+    # Every endpoint of finite_solutions is in the table (Bertini 1 prints one of the paths of a
+    # multiple root in main_data; the others agree with it to the tracking accuracy).
+    finite = read_solution_list(fixtures_dir / case / "finite_solutions")
+    pts = out.points()
+    for p in finite:
+        assert np.abs(pts - p).max(axis=1).min() < 1e-9
+    params = make_params(case)
+    table = classify(params, polynomial_system(params), out.endpoints, out.variables)
+    assert len(table) == distinct
+    assert int(table["is_real"].sum()) == real
+    assert table["multiplicity"].sum() == endpoints
+
+
+def test_fresh_bertini2_run_has_same_table_shape(fixtures_dir, tmp_path):
+    """bertini2 on the fixture's own input parses into the same columns and the same solutions."""
+    b1 = read_output(fixtures_dir / "case1")
+    run = run_bertini(
+        (fixtures_dir / "case1" / "input").read_text(), tmp_path / "b2", find_engine(), timeout=120
+    )
+    b2 = read_output(run.folder)
+    assert b2.layout == "bertini2"
+    assert list(b2.endpoints.columns) == list(b1.endpoints.columns)
+    assert dict(b2.endpoints.dtypes) == dict(b1.endpoints.dtypes)
+    params = make_params("case1")
+    system = polynomial_system(params)
+    t1 = classify(params, system, b1.endpoints, b1.variables)
+    t2 = classify(params, system, b2.endpoints, b2.variables)
+    assert list(t1.columns) == list(t2.columns)
+    assert len(t1) == len(t2) == 6
+    for a, b in zip(t1.itertuples(), t2.itertuples(), strict=True):
+        assert abs(a.gamma1_deg - b.gamma1_deg) < 1e-8 and abs(a.gamma2_deg - b.gamma2_deg) < 1e-8
+
+
+def test_malformed_files_raise(fixtures_dir, tmp_path):
+    """A truncated solution list or an unknown main_data layout is an error, not a short table."""
+    folder = tmp_path / "bad"
+    shutil.copytree(fixtures_dir / "case1", folder)
+    (folder / "finite_solutions").chmod(0o644)
+    text = (folder / "finite_solutions").read_text().split("\n")
+    (folder / "finite_solutions").write_text("\n".join(text[:8]))
+    with pytest.raises(ParseError, match="header says 6"):
+        read_output(folder)
+    (folder / "main_data").chmod(0o644)
+    (folder / "main_data").write_text("garbage\n")
+    with pytest.raises(ParseError, match="layout"):
+        read_output(folder)

@@ -73,7 +73,7 @@ def _params(args: argparse.Namespace):
 
 def _print_table(solved, folder: Path, record: dict) -> None:
     s = solved.solutions
-    real = s[s["is_real"] | (s["reason"] == "zero_length_spring")]
+    real = s[s["is_real"]]
     c = record["counts"]
     print(
         f"{record['label']}: {c['distinct_solutions']} distinct finite solutions "

@@ -5,7 +5,7 @@ BIN     := $(VENV)/bin
 STAMP   := $(VENV)/.installed
 CLI     := $(BIN)/cotm-bertini
 
-.PHONY: install case1 case2 case3 test lint format clean-runs
+.PHONY: install phcpack case1 case2 case3 test verify paper lint format clean-runs
 
 $(STAMP): pyproject.toml
 	@$(PY) -c 'import venv, ensurepip' 2>/dev/null || { \
@@ -17,11 +17,23 @@ $(STAMP): pyproject.toml
 
 install: $(STAMP)
 
+# PHCpack (Debian) is a peer solver for cross-checks and benchmarks only.
+phcpack:
+	@command -v phc >/dev/null || { \
+	  echo "installing Debian phcpack"; \
+	  apt-get update -qq && apt-get install -y -qq phcpack >/dev/null; }
+
 case1 case2 case3: $(STAMP)
 	$(CLI) solve $@
 
-test: $(STAMP)
+test: $(STAMP) phcpack
 	$(BIN)/pytest -q
+
+verify: $(STAMP) phcpack
+	$(CLI) verify case1 && $(CLI) verify case2 && $(CLI) verify case3
+
+paper: $(STAMP)
+	$(CLI) paper --out runs/paper
 
 lint: $(STAMP)
 	$(BIN)/ruff check cotm_bertini tests

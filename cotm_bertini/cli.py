@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import tempfile
 from pathlib import Path
 
 from .engine import EngineError
@@ -57,8 +58,88 @@ def _parser() -> argparse.ArgumentParser:
         metavar="PATH",
         help="a Bertini 1.x binary instead of bertini2 (also $COTM_BERTINI)",
     )
+    s.add_argument(
+        "--no-plots", action="store_true", help="skip the figures (and the import of matplotlib)"
+    )
     s.add_argument("--quiet", action="store_true", help="print only where the files are")
+    v = sub.add_parser("verify", help="cross-check a case by independent routes")
+    v.add_argument("case", nargs="?", choices=sorted(CASES), default="case3")
+    v.add_argument("--params", metavar="FILE.toml")
+    v.add_argument("--set", action="append", default=[], metavar="NAME=VALUE")
+    v.add_argument("--seed", type=int, default=1, help="Bertini and PHCpack seed (default 1)")
+    v.add_argument("--timeout", type=float, default=600.0)
+    v.add_argument("--threads", type=int, default=None)
+    v.add_argument("--mptype", type=int, default=2, choices=(0, 1, 2))
+    v.add_argument("--bertini", metavar="PATH")
+    pp = sub.add_parser("paper", help="compare Tables 2-4 of the paper with our solutions")
+    pp.add_argument("--out", metavar="DIR", default="runs/paper", help="default runs/paper")
+    pp.add_argument("--seed", type=int, default=1, help="Bertini RandomSeed (default 1)")
     return ap
+
+
+def _paper(args: argparse.Namespace) -> int:
+    from .geometry import TABLE1
+    from .paper import K_RATIO
+    from .pipeline import solve_in
+    from .report import Scenario, build_report
+    from .results import write_csv, write_text
+
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    scenarios = []
+    for name, k2 in (
+        ("Table 1 as printed (k2/k1 = 1)", TABLE1["k2"]),
+        (f"k2/k1 = {K_RATIO} (NOTES.md)", TABLE1["k1"] * K_RATIO),
+    ):
+        params, tables, paths = {}, {}, {}
+        for case in ("case1", "case2", "case3"):
+            p = make_params(case, {"k2": k2})
+            with tempfile.TemporaryDirectory(prefix="cotm-paper-") as tmp:
+                solved = solve_in(Path(tmp) / "run", p, Settings(seed=args.seed))
+            params[case], tables[case], paths[case] = p, solved.solutions, solved.paths_tracked
+            print(f"{name}, {case}: {len(solved.solutions)} solutions", file=sys.stderr)
+        scenarios.append(Scenario(name, params, tables, paths))
+    text, rows = build_report(scenarios)
+    write_text(out / "report.md", text)
+    write_csv(out / "rows.csv", rows)
+    print(f"report: {out / 'report.md'}, rows: {out / 'rows.csv'}")
+    return 0
+
+
+def _verify(args: argparse.Namespace) -> int:
+    from .pipeline import solve
+    from .verify import verify
+
+    params = _params(args)
+    settings = Settings(
+        seed=args.seed,
+        timeout=args.timeout,
+        threads=args.threads,
+        mptype=args.mptype,
+        bertini=args.bertini,
+    )
+    solutions = solve(params, settings)
+    phys = int(solutions["physical"].sum())
+    print(
+        f"{args.case}: Bertini finds {len(solutions)} distinct finite solutions "
+        f"({int(solutions['is_real'].sum())} real, {phys} physical)"
+    )
+    results = verify(params, solutions, seed=args.seed)
+    width = max(len(r.route) for r in results)
+    for r in results:
+        verdict = {True: "agrees", False: "DISAGREES", None: "n/a"}[r.agrees]
+        gap = (
+            ""
+            if r.max_disagreement_deg != r.max_disagreement_deg
+            else (f", max gap {r.max_disagreement_deg:.1e} deg")
+        )
+        print(
+            f"  {r.route:<{width}}  {verdict:<9} {r.found}{gap}"
+            + (f" ({r.note})" if r.note else "")
+        )
+    bad = [r.route for r in results if r.agrees is False]
+    print("all routes agree" if not bad else f"disagreement: {', '.join(bad)}")
+    return 1 if bad else 0
 
 
 def _params(args: argparse.Namespace):
@@ -94,7 +175,11 @@ def _print_table(solved, folder: Path, record: dict) -> None:
             "reason",
         ]
         print(real[cols].to_string(index=False, float_format=lambda v: f"{v:.4f}"))
-    print(f"files: {folder}/solutions.csv, run.json, input, Bertini output")
+    figures = ", ".join(record["figures"])
+    print(
+        f"files: {folder}/solutions.csv, run.json, input, Bertini output"
+        + (f", {figures}" if figures else "")
+    )
 
 
 def _solve(args: argparse.Namespace) -> int:
@@ -109,7 +194,18 @@ def _solve(args: argparse.Namespace) -> int:
         bertini=args.bertini,
     )
     root = Path(args.out) if args.out else Path("runs") / args.case
-    folder, solved, record = run_and_record(params, settings, root, args.case, command=sys.argv[:])
+    folder, solved, record = run_and_record(
+        params, settings, root, args.case, command=sys.argv[:], plots=not args.no_plots
+    )
+    morse = record["morse"]
+    if not morse["ok"]:
+        print(
+            "cotm-bertini: warning: #min - #saddle + #max (+ zero-length maxima) = "
+            f"{morse['euler_characteristic']} != 0 on the torus"
+            + (f", {morse['degenerate']} degenerate" if morse["degenerate"] else "")
+            + ": equilibria may be missing",
+            file=sys.stderr,
+        )
     if args.quiet:
         print(folder)
     else:
@@ -123,6 +219,10 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if args.command == "solve":
             return _solve(args)
+        if args.command == "verify":
+            return _verify(args)
+        if args.command == "paper":
+            return _paper(args)
     except ParameterError as exc:
         print(f"cotm-bertini: error: {exc}", file=sys.stderr)
         return EXIT_USAGE

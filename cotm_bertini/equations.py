@@ -203,15 +203,16 @@ def _energy_fns():
     )
 
 
-def _broadcast(value, n: int) -> np.ndarray:
-    return np.broadcast_to(np.asarray(value, dtype=float), (n,))
+def _broadcast(value, shape: tuple[int, ...]) -> np.ndarray:
+    # lambdify returns a bare scalar for a constant entry; give it the shape of the angles.
+    return np.broadcast_to(np.asarray(value, dtype=float), shape)
 
 
 def energy(params: Params, g1: np.ndarray, g2: np.ndarray) -> np.ndarray:
     """Potential energy at angles (radians)."""
     g1, g2 = np.broadcast_arrays(np.asarray(g1, float), np.asarray(g2, float))
     fn = _energy_fns()[0]
-    return _broadcast(fn(g1, g2, *params.as_dict().values()), g1.size).reshape(g1.shape)
+    return _broadcast(fn(g1, g2, *params.as_dict().values()), g1.shape)
 
 
 def energy_gradient(params: Params, g1: np.ndarray, g2: np.ndarray) -> np.ndarray:
@@ -219,7 +220,7 @@ def energy_gradient(params: Params, g1: np.ndarray, g2: np.ndarray) -> np.ndarra
     g1, g2 = np.broadcast_arrays(np.atleast_1d(np.asarray(g1, float)), np.atleast_1d(g2))
     fn = _energy_fns()[1]
     vals = fn(g1, g2, *params.as_dict().values())
-    return np.stack([_broadcast(v, g1.size).reshape(g1.shape) for v in vals], axis=-1)
+    return np.stack([_broadcast(v, g1.shape) for v in vals], axis=-1)
 
 
 def energy_hessian(params: Params, g1: np.ndarray, g2: np.ndarray) -> np.ndarray:
@@ -227,5 +228,44 @@ def energy_hessian(params: Params, g1: np.ndarray, g2: np.ndarray) -> np.ndarray
     g1, g2 = np.broadcast_arrays(np.atleast_1d(np.asarray(g1, float)), np.atleast_1d(g2))
     fn = _energy_fns()[2]
     vals = fn(g1, g2, *params.as_dict().values())
-    flat = [_broadcast(v, g1.size).reshape(g1.shape) for row in vals for v in row]
+    flat = [_broadcast(v, g1.shape) for row in vals for v in row]
     return np.stack(flat, axis=-1).reshape(*g1.shape, 2, 2)
+
+
+# --- the paper's tan-half form (for its stability criterion) -------------------------------
+
+X1, X2 = sp.symbols("x1 x2")
+
+
+@cache
+def tan_half_system(zfl: tuple[bool, bool]) -> tuple[tuple[sp.Symbol, ...], tuple[sp.Expr, ...]]:
+    """Eqs. (14)-(15), (21)-(23), (28)-(31): our equations with c = (1-x^2)/(1+x^2),
+    s = 2x/(1+x^2), cleared of denominators by (1+x1^2)(1+x2^2); the unit circles drop out."""
+    sym = derive(zfl)
+    subs = {
+        sp.Symbol("c1"): (1 - X1**2) / (1 + X1**2),
+        sp.Symbol("s1"): 2 * X1 / (1 + X1**2),
+        sp.Symbol("c2"): (1 - X2**2) / (1 + X2**2),
+        sp.Symbol("s2"): 2 * X2 / (1 + X2**2),
+    }
+    clear = (1 + X1**2) * (1 + X2**2)
+    eqs = tuple(
+        sp.expand(sp.cancel(f.subs(subs) * clear))
+        for f, name in zip(sym.functions, sym.names, strict=True)
+        if not name.startswith("circle")
+    )
+    variables = (X1, X2) + tuple(sp.Symbol(v) for v in sym.variables if v.startswith("d"))
+    return variables, eqs
+
+
+@cache
+def _tan_half_jacobian_fn(zfl: tuple[bool, bool]):
+    variables, eqs = tan_half_system(zfl)
+    jac = sp.Matrix(eqs).jacobian(variables)
+    return sp.lambdify((*variables, *P), jac, "numpy")
+
+
+def tan_half_jacobian(params: Params, point: tuple[complex, ...]) -> np.ndarray:
+    """Jacobian of the paper's equations (F, tau, C1, C2) in (x1, x2, d1, d2) at one point."""
+    fn = _tan_half_jacobian_fn(params.zfl)
+    return np.array(fn(*point, *params.as_dict().values()), dtype=complex)

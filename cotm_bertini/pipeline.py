@@ -20,7 +20,7 @@ from .render import render_input
 from .results import write_csv, write_json
 from .settings import Settings
 from .solver import run_bertini
-from .stability import Tolerances, classify
+from .stability import Tolerances, classify, morse_check
 
 
 @dataclass
@@ -123,7 +123,8 @@ def run_and_record(
     label: str,
     command: list[str] | None = None,
     tolerances: Tolerances = Tolerances(),
-) -> tuple[Path, Solved | None, dict]:
+    plots: bool = True,
+) -> tuple[Path, Solved, dict]:
     """Solve into a new run folder under root with solutions.csv and run.json.
 
     The folder is built under a hidden name and renamed when complete; a failed run is renamed
@@ -154,10 +155,17 @@ def run_and_record(
         write_json(work / "run.json", record)
         work.rename(final.with_name(final.name + "-failed"))
         raise
-    t_write = time.perf_counter()
-    write_csv(work / "solutions.csv", solved.solutions)
     timings = dict(solved.timings)
-    timings["write"] = time.perf_counter() - t_write
+    with_stage = Timings(timings)
+    with with_stage.stage("write"):
+        write_csv(work / "solutions.csv", solved.solutions)
+    if plots:
+        with with_stage.stage("plot"):
+            from .plot import plot_run  # matplotlib only when pictures are asked for
+
+            figures = [p.name for p in plot_run(params, solved.solutions, work)]
+    else:
+        figures = []
     timings["total"] = time.perf_counter() - start
     record.update(
         status="ok",
@@ -174,6 +182,8 @@ def run_and_record(
             "total_degree": solved.system.total_degree,
         },
         counts=summary_counts(solved),
+        morse=morse_check(params, solved.solutions),
+        figures=figures,
         timings=timings,
     )
     write_json(work / "run.json", record)

@@ -25,6 +25,11 @@ def atomic_write_text(path: Path, text: str) -> None:
         raise
 
 
+def write_text(path: Path, text: str) -> None:
+    """Text, written atomically."""
+    atomic_write_text(path, text)
+
+
 def write_csv(path: Path, frame: pd.DataFrame) -> None:
     """A CSV that loads straight into pandas or a spreadsheet, written atomically."""
     atomic_write_text(path, frame.to_csv(index=False))

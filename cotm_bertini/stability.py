@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from .equations import PolySystem, energy, energy_hessian
+from .equations import PolySystem, energy, energy_hessian, tan_half_jacobian
 from .geometry import Params
 
 
@@ -60,7 +60,8 @@ def cluster_endpoints(
         for j in range(i + 1, n):
             if labels[j] >= 0:
                 continue
-            limit = max(loose[i], loose[j]) if (singular[i] or singular[j]) else tol
+            # Only two singular endpoints are merged loosely: a regular root is never swallowed.
+            limit = max(loose[i], loose[j]) if (singular[i] and singular[j]) else tol
             if np.abs(x[i] - x[j]).max() <= limit * max(mag[i], mag[j]):
                 labels[j] = group
         group += 1
@@ -168,6 +169,7 @@ def classify(
     frame["singular"] = sing
 
     _mechanics(frame, params, g1r, g2r, vec, length, physical & ~sing, tol)
+    frame["paper_stable"] = paper_criterion(params, frame)
     frame["paths"] = [r["paths"] for r in rows]
     for name in variables:
         frame[f"{name}_re"] = v[name].real
@@ -271,3 +273,96 @@ def _order(frame: pd.DataFrame) -> pd.DataFrame:
 def _empty_frame(variables: tuple[str, ...]) -> pd.DataFrame:
     cols = COLUMNS + [f"{n}_{p}" for n in variables for p in ("re", "im")]
     return pd.DataFrame({c: pd.Series(dtype=float) for c in cols})
+
+
+def paper_criterion(params: Params, frame: pd.DataFrame) -> np.ndarray:
+    """The paper's "stable": all eigenvalues of the Jacobian of its tan-half equations (F, tau,
+    C1, C2 in x1, x2, d1, d2) have negative real parts. Evaluated on real rows, as the paper does;
+    False for complex rows and where gamma = 180 deg (x = tan(gamma/2) is infinite there)."""
+    out = np.zeros(len(frame), dtype=bool)
+    for k, row in enumerate(frame.itertuples(index=False)):
+        if not row.is_real:
+            continue
+        half = np.radians([row.gamma1_deg, row.gamma2_deg]) / 2
+        if np.abs(np.cos(half)).min() < 1e-8:
+            continue
+        point = [*np.tan(half)]
+        point += [getattr(row, f"d{i}") for i in (1, 2) if not params.zfl[i - 1]]
+        eig = np.linalg.eigvals(tan_half_jacobian(params, tuple(point)))
+        out[k] = bool(np.all(eig.real < 0))
+    return out
+
+
+def _anchor_jacobian(params: Params, spring: int, g1: float, g2: float) -> np.ndarray:
+    """d(P_spring)/d(gamma1, gamma2): columns L3 u'(gamma1) and R'(gamma2) q."""
+    q = (params.p6x, 0.0) if spring == 1 else (params.p5x, params.p5y)
+    c1, s1, c2, s2 = np.cos(g1), np.sin(g1), np.cos(g2), np.sin(g2)
+    return np.array(
+        [[-params.L3 * s1, -s2 * q[0] - c2 * q[1]], [params.L3 * c1, c2 * q[0] - s2 * q[1]]]
+    )
+
+
+def zero_length_configurations(params: Params) -> list[dict]:
+    """Real configurations where a spring with L0 > 0 has zero length (P6 = P2 or P5 = P3).
+
+    V has a cone point there: V = 1/2 k L0^2 - k L0 |P| + (the other spring's energy). It is a
+    local maximum (`is_max`) when the other spring's pull, carried to the coincident point
+    (J^-T grad V_other), is weaker than the k L0 push of the collapsed spring; otherwise the cone
+    is tilted over and the point is not critical at all. Closed form: P4 = L3 u(gamma1) lies on
+    |P4| = L3 and on the circle of radius |q| around the bottom anchor (q: top anchor in T).
+    """
+    found = []
+    springs = {
+        1: ((params.p2x, 0.0), (params.p6x, 0.0), params.k1, params.L01),
+        2: ((params.p3x, params.p3y), (params.p5x, params.p5y), params.k2, params.L02),
+    }
+    for spring, (anchor, q, k, free_length) in springs.items():
+        if free_length == 0:
+            continue
+        a = np.array(anchor)
+        r1, r2, dist = params.L3, float(np.hypot(*q)), float(np.hypot(*a))
+        along = (dist**2 + r1**2 - r2**2) / (2 * dist)
+        h2 = r1**2 - along**2
+        if h2 < 0:
+            continue
+        ex = a / dist
+        ey = np.array([-ex[1], ex[0]])
+        for sign in (1.0, -1.0) if h2 > 0 else (1.0,):
+            p4 = along * ex + sign * np.sqrt(h2) * ey
+            g1 = float(np.arctan2(p4[1], p4[0]))
+            w = a - p4  # = R(gamma2) q
+            g2 = float(np.arctan2(w[1], w[0]) - np.arctan2(q[1], q[0]))
+            other = 2 if spring == 1 else 1
+            vec = spring_vectors(params, np.array([g1]), np.array([g2]))[f"spring{other}"][0]
+            ko, L0o = (params.k2, params.L02) if other == 2 else (params.k1, params.L01)
+            length = float(np.hypot(*vec))
+            grad_other = (
+                ko * (length - L0o) / length * (_anchor_jacobian(params, other, g1, g2).T @ vec)
+            )
+            jac = _anchor_jacobian(params, spring, g1, g2)
+            pull = float(np.linalg.norm(np.linalg.solve(jac.T, grad_other)))
+            found.append(
+                {
+                    "spring": spring,
+                    "gamma1_deg": float(np.degrees(g1) % 360),
+                    "gamma2_deg": float(np.degrees(g2) % 360),
+                    "pull": pull,
+                    "push": k * free_length,
+                    "is_max": pull < k * free_length,
+                }
+            )
+    return found
+
+
+def morse_check(params: Params, frame: pd.DataFrame) -> dict:
+    """#min - #saddle + #max over the physical equilibria, zero-length cusps counted as maxima.
+
+    The torus has Euler characteristic 0, so a non-zero total means equilibria are missing (or a
+    degenerate one makes the count inapplicable).
+    """
+    phys = frame[frame["physical"]]
+    counts = {k: int((phys["kind"] == k).sum()) for k in ("min", "saddle", "max", "degenerate")}
+    cusps = sum(c["is_max"] for c in zero_length_configurations(params))
+    total = counts["min"] - counts["saddle"] + counts["max"] + cusps
+    ok = total == 0 and counts["degenerate"] == 0
+    return {**counts, "zero_length_maxima": cusps, "euler_characteristic": total, "ok": ok}

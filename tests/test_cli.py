@@ -47,7 +47,15 @@ def test_solve_case1_writes_run_folder(tmp_path):
     assert len(runs) == 1
     run = runs[0]
     assert str(run) in r.stdout
-    for name in ("solutions.csv", "input", "run.json", "main_data", "finite_solutions"):
+    for name in (
+        "solutions.csv",
+        "input",
+        "run.json",
+        "main_data",
+        "finite_solutions",
+        "configurations.png",
+        "energy_map.svg",
+    ):
         assert (run / name).is_file(), name
     table = pd.read_csv(run / "solutions.csv")
     assert list(table.columns[: len(REQUIRED)]) == REQUIRED
@@ -62,6 +70,7 @@ def test_solve_case1_writes_run_folder(tmp_path):
     for stage in ("derive", "render", "solve", "parse", "classify", "write", "total"):
         assert rec["timings"][stage] >= 0
     assert rec["counts"]["distinct_solutions"] == 6
+    assert rec["morse"]["ok"] and rec["morse"]["euler_characteristic"] == 0
     assert not list(tmp_path.glob(".partial-*"))
 
 
@@ -162,3 +171,13 @@ def test_user_bertini1_binary(tmp_path, fixtures_dir, case):
     expected = {"case1": (8, 6, 4), "case2": (48, 22, 10), "case3": (192, 76, 30)}[case]
     c = rec["counts"]
     assert (c["paths_tracked"], c["distinct_solutions"], c["real"]) == expected
+
+
+def test_verify_case1_all_routes_agree():
+    """verify: Morse count, energy route, resultant and PHCpack all agree with Bertini."""
+    r = cli("verify", "case1")
+    assert r.returncode == 0, r.stdout + r.stderr
+    for route in ("Morse count", "energy Newton", "Sylvester resultant", "PHCpack"):
+        line = next(ln for ln in r.stdout.splitlines() if route in ln)
+        assert " agrees " in line, line
+    assert "all routes agree" in r.stdout

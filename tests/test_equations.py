@@ -12,15 +12,13 @@ P4 = L3 [c1, s1], rotated by gamma2), P6 = [p6x, 0], P5 = [p5x, p5y]. Spring 1 j
 spring 2 joins P3 and P5, the rod joins P1 and P4.
 """
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 import sympy as sp
+from conftest import FIXTURES
 
 from cotm_bertini import equations, geometry
 
-FIXTURES = Path("/work/shared/fixtures/bertini-1.6")
 ZFL_PATTERNS = [(True, True), (False, True), (True, False), (False, False)]
 GEOMETRY_NAMES = ("L3", "k1", "k2", "p2x", "p3x", "p3y", "p6x", "p5x", "p5y")
 
@@ -310,6 +308,13 @@ def test_appendix_a_tan_half_coefficients_and_b9_typo():
     # Eq. (14) read literally (A1 x1^2 x1^2) is not our force equation, not even up to a factor.
     eq14_literal = sp.Poly(eq14.as_expr() - A[1] * x2**2 * x1**2 + A[1] * x1**4, x1, x2)
     assert factor_between(tf, eq14_literal) is None
+
+    # The system behind the paper's stability criterion (eq. (20)) is exactly (14), (15).
+    tvars, teqs = equations.tan_half_system((True, True))
+    names = {str(t): t for t in tvars}
+    swap = {names["x1"]: x1, names["x2"]: x2}
+    assert sp.expand(teqs[0].subs(swap) - eq14.as_expr()) == 0
+    assert sp.expand(teqs[1].subs(swap) - eq15_fixed.as_expr()) == 0
 
 
 # --- 4. Bertini 1.6 fixture inputs -----------------------------------------------------------

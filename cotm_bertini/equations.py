@@ -9,6 +9,7 @@ import numpy as np
 import sympy as sp
 
 from .geometry import PARAM_NAMES, Params
+from .polynomial import ParametricSystem, PolySystem
 
 ANGLE_VARS = ("c1", "s1", "c2", "s2")
 
@@ -90,88 +91,39 @@ def derive(zfl: tuple[bool, bool]) -> SymbolicSystem:
     return SymbolicSystem(zfl, names, tuple(labels), tuple(eqs))
 
 
-@dataclass(frozen=True)
-class _CompiledTerms:
-    exponents: tuple[np.ndarray, ...]
-    coeff_fns: tuple  # one callable per function: params -> coefficients
-
-
 @cache
-def _compile(zfl: tuple[bool, bool]) -> _CompiledTerms:
+def parametric_system(zfl: tuple[bool, bool]) -> ParametricSystem:
+    """`derive` as numbers: sparse terms in the variables and the parameters, and Bertini text."""
     sym = derive(zfl)
     xs = [sp.Symbol(n) for n in sym.variables]
-    exps, fns = [], []
+    used = sorted(
+        {s.name for f in sym.functions for s in f.free_symbols} & set(PARAM_NAMES),
+        key=PARAM_NAMES.index,
+    )
+    ps = [PSYM[n] for n in used]
+    var_exps, par_exps, coeffs, texts = [], [], [], []
     for f in sym.functions:
-        poly = sp.Poly(f, *xs)
+        poly = sp.Poly(f, *xs, *ps)
         terms = poly.terms()
-        exps.append(np.array([m for m, _ in terms], dtype=np.int64))
-        fns.append(sp.lambdify(P, [c for _, c in terms], "math"))
-    return _CompiledTerms(tuple(exps), tuple(fns))
-
-
-@dataclass(frozen=True)
-class PolySystem:
-    """A square polynomial system with numeric coefficients: one (exponents, coefficients) a row."""
-
-    variables: tuple[str, ...]
-    names: tuple[str, ...]
-    exponents: tuple[np.ndarray, ...]
-    coefficients: tuple[np.ndarray, ...]
-
-    @property
-    def degrees(self) -> tuple[int, ...]:
-        """Total degree of each function."""
-        return tuple(int(e.sum(axis=1).max()) for e in self.exponents)
-
-    @property
-    def total_degree(self) -> int:
-        """Bezout number: the path count of a total-degree homotopy."""
-        return int(np.prod(self.degrees))
-
-    def evaluate(self, x: np.ndarray) -> np.ndarray:
-        """Values of every function at the rows of x, shape (n_points, n_functions)."""
-        x = np.atleast_2d(np.asarray(x, dtype=complex))
-        out = np.empty((x.shape[0], len(self.exponents)), dtype=complex)
-        for i, (e, c) in enumerate(zip(self.exponents, self.coefficients, strict=True)):
-            out[:, i] = np.prod(x[:, None, :] ** e[None, :, :], axis=2) @ c
-        return out
-
-    def jacobian(self, x: np.ndarray) -> np.ndarray:
-        """Jacobian at the rows of x, shape (n_points, n_functions, n_variables)."""
-        x = np.atleast_2d(np.asarray(x, dtype=complex))
-        n, m = x.shape
-        jac = np.zeros((n, len(self.exponents), m), dtype=complex)
-        for i, (e, c) in enumerate(zip(self.exponents, self.coefficients, strict=True)):
-            for j in range(m):
-                ej = e[:, j]
-                mask = ej > 0
-                if not mask.any():
-                    continue
-                de = e[mask].copy()
-                de[:, j] -= 1
-                jac[:, i, j] = np.prod(x[:, None, :] ** de[None, :, :], axis=2) @ (
-                    c[mask] * ej[mask]
-                )
-        return jac
-
-    def scale(self) -> np.ndarray:
-        """Largest coefficient magnitude of each function, to make residuals relative."""
-        return np.array([np.abs(c).max() for c in self.coefficients])
+        var_exps.append(np.array([m[: len(xs)] for m, _ in terms], dtype=np.int64))
+        par_exps.append(np.array([m[len(xs) :] for m, _ in terms], dtype=np.int64))
+        coeffs.append(np.array([float(c) for _, c in terms], dtype=float))
+        texts.append(sp.sstr(f).replace("**", "^"))
+    return ParametricSystem(
+        sym.variables,
+        sym.names,
+        tuple(used),
+        tuple(var_exps),
+        tuple(par_exps),
+        tuple(coeffs),
+        tuple(texts),
+    )
 
 
 def polynomial_system(params: Params) -> PolySystem:
     """The equations of `derive` with the parameter values substituted."""
-    compiled = _compile(params.zfl)
-    sym = derive(params.zfl)
-    values = [getattr(params, n) for n in PARAM_NAMES]
-    coeffs = tuple(np.array(fn(*values), dtype=float) for fn in compiled.coeff_fns)
-    # Drop terms whose coefficient vanishes for these values (e.g. a zero parameter).
-    exps, cfs = [], []
-    for e, c in zip(compiled.exponents, coeffs, strict=True):
-        keep = c != 0.0
-        exps.append(e[keep])
-        cfs.append(c[keep])
-    return PolySystem(sym.variables, sym.names, tuple(exps), tuple(cfs))
+    ps = parametric_system(params.zfl)
+    return ps.instantiate([getattr(params, n) for n in ps.parameters])
 
 
 # --- energy in the angles -------------------------------------------------------------------

@@ -7,6 +7,8 @@ import tomllib
 from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
 
+import numpy as np
+
 PARAM_NAMES = ("L3", "k1", "k2", "p2x", "p3x", "p3y", "p6x", "p5x", "p5y", "L01", "L02")
 
 PARAM_UNITS = {
@@ -165,3 +167,16 @@ def make_params(
     for name, value in (overrides or {}).items():
         values[name] = _coerce(name, value)
     return Params(**values)
+
+
+def spring_vectors_cs(params: Params, c1, s1, c2, s2) -> dict[str, np.ndarray]:
+    """Spring vectors 2 -> 6, 3 -> 5 and the rod 1 -> 4 in frame B from c_i, s_i (any dtype)."""
+    p = params
+    p4 = np.stack([p.L3 * c1, p.L3 * s1], axis=-1)
+    p6 = p4 + np.stack([c2 * p.p6x, s2 * p.p6x], axis=-1)
+    p5 = p4 + np.stack([c2 * p.p5x - s2 * p.p5y, s2 * p.p5x + c2 * p.p5y], axis=-1)
+    return {
+        "spring1": p6 - np.array([p.p2x, 0.0]),
+        "spring2": p5 - np.array([p.p3x, p.p3y]),
+        "rod": p4,
+    }

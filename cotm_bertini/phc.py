@@ -28,8 +28,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .equations import PolySystem
 from .parse import METADATA_COLUMNS
+from .polynomial import PolySystem
 
 PHC_COMMAND = "phc"
 INSTALL_HINT = "run `apt-get install phcpack` (Debian package phcpack, command `phc`)"

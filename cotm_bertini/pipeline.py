@@ -13,9 +13,10 @@ from pathlib import Path
 import pandas as pd
 
 from . import engine as engine_mod
-from .equations import PolySystem, polynomial_system
+from .equations import polynomial_system
 from .geometry import Params
 from .parse import BertiniOutput, read_output
+from .polynomial import PolySystem
 from .render import render_input
 from .results import write_csv, write_json
 from .settings import Settings

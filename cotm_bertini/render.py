@@ -8,7 +8,7 @@ from pathlib import Path
 import jinja2
 import numpy as np
 
-from .equations import PolySystem
+from .polynomial import ParametricSystem, PolySystem
 from .settings import Settings
 
 TEMPLATES = Path(__file__).resolve().parent.parent / "templates"
@@ -30,12 +30,28 @@ def _number(c: float) -> str:
     return repr(float(c))
 
 
+def complex_number(z: complex) -> str:
+    """A Bertini literal for a (possibly complex) number: (re+im*I)."""
+    z = complex(z)
+    if z.imag == 0:
+        return f"({_number(z.real)})"
+    sign = "+" if z.imag >= 0 else "-"
+    return f"({_number(z.real)}{sign}{_number(abs(z.imag))}*I)"
+
+
 def _monomial(names: tuple[str, ...], exps: np.ndarray) -> str:
     return "*".join(n if e == 1 else f"{n}^{e}" for n, e in zip(names, exps, strict=True) if e)
 
 
 def polynomial_text(names: tuple[str, ...], exps: np.ndarray, coeffs: np.ndarray) -> str:
     """One polynomial in Bertini syntax, terms in a fixed (graded) order."""
+    if np.iscomplexobj(coeffs) and np.any(np.imag(coeffs) != 0):
+        terms = [
+            complex_number(c) + (f"*{_monomial(names, e)}" if e.any() else "")
+            for e, c in zip(exps, coeffs, strict=True)
+        ]
+        return " + ".join(terms) if terms else "0"
+    coeffs = np.real(coeffs)
     order = sorted(range(len(coeffs)), key=lambda i: (-int(exps[i].sum()), tuple(-exps[i])))
     parts = []
     for i in order:
@@ -76,4 +92,33 @@ def render_input(
             variable_groups=variable_groups(system, settings),
             functions=functions,
         )
+    )
+
+
+def render_system(system: PolySystem) -> str:
+    """A bare INPUT section (no CONFIG) for Bertini 2's in-process parser; complex allowed."""
+    functions = [
+        {"name": n, "text": polynomial_text(system.variables, e, c)}
+        for n, e, c in zip(system.names, system.exponents, system.coefficients, strict=True)
+    ]
+    return (
+        _environment()
+        .get_template("system.input.j2")
+        .render(variables=system.variables, functions=functions)
+    )
+
+
+def render_parameter_homotopy(
+    ps: ParametricSystem, start: dict[str, complex], target: dict[str, complex]
+) -> str:
+    """INPUT section of the homotopy moving the parameters from `start` (t=1) to `target` (t=0)."""
+    parameters = [
+        {"name": n, "start": complex_number(start[n]), "target": complex_number(target[n])}
+        for n in ps.parameters
+    ]
+    functions = [{"name": n, "text": t} for n, t in zip(ps.names, ps.texts, strict=True)]
+    return (
+        _environment()
+        .get_template("parameter_homotopy.input.j2")
+        .render(variables=ps.variables, parameters=parameters, functions=functions)
     )

@@ -7,8 +7,9 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from .equations import PolySystem, energy, energy_hessian, tan_half_jacobian
-from .geometry import Params
+from .equations import energy, energy_hessian, tan_half_jacobian
+from .geometry import Params, spring_vectors_cs
+from .polynomial import PolySystem
 
 
 @dataclass(frozen=True)
@@ -75,16 +76,7 @@ def complex_angles(c: np.ndarray, s: np.ndarray) -> np.ndarray:
 
 def spring_vectors(params: Params, g1: np.ndarray, g2: np.ndarray) -> dict[str, np.ndarray]:
     """Points 2 -> 6 and 3 -> 5 and the rod 1 -> 4, in frame B, for real angles (radians)."""
-    p = params
-    c1, s1, c2, s2 = np.cos(g1), np.sin(g1), np.cos(g2), np.sin(g2)
-    p4 = np.stack([p.L3 * c1, p.L3 * s1], axis=-1)
-    p6 = p4 + np.stack([c2 * p.p6x, s2 * p.p6x], axis=-1)
-    p5 = p4 + np.stack([c2 * p.p5x - s2 * p.p5y, s2 * p.p5x + c2 * p.p5y], axis=-1)
-    return {
-        "spring1": p6 - np.array([p.p2x, 0.0]),
-        "spring2": p5 - np.array([p.p3x, p.p3y]),
-        "rod": p4,
-    }
+    return spring_vectors_cs(params, np.cos(g1), np.sin(g1), np.cos(g2), np.sin(g2))
 
 
 def classify(

@@ -1,0 +1,347 @@
+"""Parameter homotopy with Bertini 2 in-process: solve once at generic parameters, then move.
+
+A total-degree solve (ab initio) at random complex parameters p0 gives the generic solution set.
+Any real target p1 is then reached by tracking those solutions while every parameter moves on
+the straight line from p0 (t = 1) to p1 (t = 0): since p0 is random complex, the line misses the
+parameter values where paths meet (the "gamma trick"). This is the Paramotopy / HomotopyContinuation
+approach; the `bertini2` command cannot do it, the `bertini` module can.
+
+The singular roots of the generic set are the d = 0 artefacts (a spring with L0 > 0 at zero
+length; NOTES.md): they are not tracked but computed at the target in closed form.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .geometry import Params, spring_vectors_cs
+from .parse import METADATA_COLUMNS
+from .polynomial import ParametricSystem
+from .render import render_parameter_homotopy, render_system
+
+# Magnitudes of the generic start parameters (random complex, this size).
+_START_SCALE = {"L3": 9.0, "k1": 3.0, "k2": 3.0, "L01": 10.0, "L02": 10.0}
+_SUCCESS = "Success"
+
+
+class HomotopyError(RuntimeError):
+    """The in-process solver failed in a way no retry repaired."""
+
+
+def _bertini():
+    import bertini
+
+    bertini.recording(False)  # never recall or store runs on disk behind our back
+    return bertini
+
+
+def cache_dir() -> Path:
+    """Where generic solution sets are kept: $COTM_CACHE or ~/.cache/cotm-bertini."""
+    root = os.environ.get("COTM_CACHE") or Path.home() / ".cache" / "cotm-bertini"
+    return Path(root)
+
+
+def _code(m) -> str:
+    return str(m.endgame_success_code).rsplit(".", 1)[-1]
+
+
+def _points(pts) -> np.ndarray:
+    return np.array([[complex(z) for z in p] for p in pts], dtype=complex)
+
+
+@dataclass(frozen=True)
+class GenericSet:
+    """The solutions of the system at generic complex parameters: the start of every homotopy."""
+
+    key: str
+    seed: int
+    start: dict[str, complex]
+    points: np.ndarray  # nonsingular finite solutions, tracked to every target
+    paths: int
+    finite_endpoints: int
+    singular_endpoints: int
+    seconds: float
+    bertini_version: str
+
+    def to_json(self) -> dict:
+        """JSON-able form (complex numbers as [re, im])."""
+        return {
+            "key": self.key,
+            "seed": self.seed,
+            "start": {k: [v.real, v.imag] for k, v in self.start.items()},
+            "points": [[[z.real, z.imag] for z in p] for p in self.points],
+            "paths": self.paths,
+            "finite_endpoints": self.finite_endpoints,
+            "singular_endpoints": self.singular_endpoints,
+            "seconds": self.seconds,
+            "bertini_version": self.bertini_version,
+        }
+
+    @classmethod
+    def from_json(cls, d: dict) -> GenericSet:
+        """Inverse of to_json."""
+        pts = np.array([[complex(*z) for z in p] for p in d["points"]], dtype=complex)
+        return cls(
+            d["key"],
+            d["seed"],
+            {k: complex(*v) for k, v in d["start"].items()},
+            pts,
+            d["paths"],
+            d["finite_endpoints"],
+            d["singular_endpoints"],
+            d["seconds"],
+            d["bertini_version"],
+        )
+
+
+def generic_key(ps: ParametricSystem, seed: int) -> str:
+    """Content hash of what a generic set depends on: equations, seed, engine version."""
+    import importlib.metadata as md
+
+    blob = json.dumps(
+        {
+            "system": ps.to_json(),
+            "seed": seed,
+            "bertini2": md.version("bertini2"),
+            "scale": _START_SCALE,
+        },
+        sort_keys=True,
+    )
+    return hashlib.sha256(blob.encode()).hexdigest()[:16]
+
+
+def generic_set(ps: ParametricSystem, seed: int = 1, use_cache: bool = True) -> GenericSet:
+    """The generic solution set of `ps` for `seed`, from the disk cache or solved ab initio."""
+    key = generic_key(ps, seed)
+    path = cache_dir() / f"generic-{key}.json"
+    if use_cache and path.is_file():
+        try:
+            return GenericSet.from_json(json.loads(path.read_text()))
+        except (ValueError, KeyError):
+            path.unlink(missing_ok=True)  # a damaged cache entry is recomputed, not trusted
+    gs = _solve_generic(ps, seed, key)
+    if use_cache:
+        from .results import atomic_write_text
+
+        path.parent.mkdir(parents=True, exist_ok=True)
+        atomic_write_text(path, json.dumps(gs.to_json()))
+    return gs
+
+
+def _solve_generic(ps: ParametricSystem, seed: int, key: str) -> GenericSet:
+    import importlib.metadata as md
+
+    bertini = _bertini()
+    from bertini import nag_algorithm as na
+
+    rng = np.random.default_rng(seed)
+    start = {}
+    for name in ps.parameters:
+        z = complex(*rng.normal(size=2)) / np.sqrt(2)
+        start[name] = _START_SCALE.get(name, 4.0) * z
+    system = ps.instantiate([start[n] for n in ps.parameters])
+    bertini.random.set_random_seed(seed)
+    t0 = time.perf_counter()
+    solver = na.ZeroDimSolver(bertini.parse.system(render_system(system)))
+    solver.solve(show_progress=False)
+    seconds = time.perf_counter() - t0
+    meta, pts = solver.solution_metadata(), solver.all_solutions()
+    finite = [i for i, m in enumerate(meta) if m.is_finite and _code(m) == _SUCCESS]
+    regular = [i for i in finite if not m_singular(meta[i])]
+    points = _points([pts[i] for i in regular])
+    return GenericSet(
+        key,
+        seed,
+        start,
+        points,
+        len(meta),
+        len(finite),
+        len(finite) - len(regular),
+        seconds,
+        md.version("bertini2"),
+    )
+
+
+def m_singular(m) -> bool:
+    """Bertini's singular flag: multiplicity > 1 or a condition number over its threshold."""
+    return bool(m.is_singular or m.multiplicity > 1)
+
+
+@dataclass
+class TrackReport:
+    """What tracking to one target did."""
+
+    tracked: int = 0
+    finite: int = 0
+    infinite: int = 0
+    retracked_adaptive: int = 0
+    lost: int = 0
+    method: str = "parameter homotopy"
+    seconds: float = 0.0
+    notes: list[str] = field(default_factory=list)
+
+    def as_dict(self) -> dict:
+        """For run.json and sweep rows."""
+        return {**self.__dict__, "notes": "; ".join(self.notes)}
+
+
+def _track(
+    ps: ParametricSystem,
+    gs: GenericSet,
+    target: dict[str, float],
+    idx: list[int],
+    mptype: str,
+    threads: int | None,
+):
+    bertini = _bertini()
+    from bertini import nag_algorithm as na
+
+    hom = bertini.parse.system(render_parameter_homotopy(ps, gs.start, target))
+    tgt = bertini.parse.system(render_system(ps.instantiate([target[n] for n in ps.parameters])))
+    solver = na.HomotopySolver(hom, [gs.points[i] for i in idx], tgt, mptype=mptype)
+    if threads is not None:
+        solver.set(num_threads=threads)
+    solver.solve(show_progress=False)
+    return solver.solution_metadata(), solver.all_solutions()
+
+
+def track(
+    ps: ParametricSystem, gs: GenericSet, params: Params, threads: int | None = None
+) -> tuple[pd.DataFrame, TrackReport]:
+    """Finite endpoints at `params` (parse.METADATA_COLUMNS + one complex column per variable).
+
+    Paths are tracked in double precision; any path that does not end in success is tracked again
+    with adaptive precision; a path that still fails is counted as lost (the caller re-solves).
+    """
+    t0 = time.perf_counter()
+    target = {n: getattr(params, n) for n in ps.parameters}
+    n = len(gs.points)
+    rep = TrackReport(tracked=n)
+    meta, pts = _track(ps, gs, target, list(range(n)), "double", threads)
+    results = {i: (meta[i], pts[i]) for i in range(n)}
+    redo = [i for i in range(n) if _code(meta[i]) != _SUCCESS or not meta[i].is_finite]
+    finite_pts = [i for i in range(n) if i not in redo]
+    if _crossing(results, finite_pts):
+        redo = list(range(n))
+        rep.notes.append("path crossing in double precision: all paths re-tracked")
+    if redo:
+        rep.retracked_adaptive = len(redo)
+        meta2, pts2 = _track(ps, gs, target, redo, "adaptive", threads)
+        for k, i in enumerate(redo):
+            results[i] = (meta2[k], pts2[k])
+    rows = []
+    for i in range(n):
+        m, p = results[i]
+        code = _code(m)
+        if code == _SUCCESS and m.is_finite:
+            d = m.to_dict()
+            rows.append(
+                {
+                    "path_number": i,
+                    "condition_number": float(d["condition_number"]),
+                    "function_residual": float(d["function_residual"]),
+                    "newton_residual": float(d["newton_residual"]),
+                    "final_t": complex(d["final_time_used"]).real,
+                    "max_precision": float(d["max_precision_used"]),
+                    "accuracy_estimate": float(d["accuracy_estimate_user_coords"]),
+                    "cycle_number": int(d["cycle_num"]),
+                    "bertini_multiplicity": int(d["multiplicity"]),
+                    "coords": [complex(z) for z in p],
+                }
+            )
+        elif code in ("GoingToInfinity", "SecurityMaxNormReached") or not m.is_finite:
+            rep.infinite += 1
+        else:
+            rep.lost += 1
+            rep.notes.append(f"path {i}: {code}")
+    rep.finite = len(rows)
+    rep.seconds = time.perf_counter() - t0
+    return _frame(ps.variables, rows), rep
+
+
+def _crossing(results: dict, idx: list[int], tol: float = 1e-7) -> bool:
+    """Two paths ending at the same nonsingular point: one of them jumped."""
+    pts = np.array(
+        [[complex(z) for z in results[i][1]] for i in idx if not m_singular(results[i][0])],
+        dtype=complex,
+    )
+    if len(pts) < 2:
+        return False
+    scale = 1.0 + np.abs(pts).max(axis=1)
+    for a in range(len(pts)):
+        d = np.abs(pts[a + 1 :] - pts[a]).max(axis=1) / np.maximum(scale[a + 1 :], scale[a])
+        if (d < tol).any():
+            return True
+    return False
+
+
+def _frame(variables: tuple[str, ...], rows: list[dict]) -> pd.DataFrame:
+    coords = np.array([r.pop("coords") for r in rows], dtype=complex).reshape(
+        len(rows), len(variables)
+    )
+    frame = pd.DataFrame.from_records(rows, columns=list(METADATA_COLUMNS))
+    for k, v in enumerate(variables):
+        frame[v] = coords[:, k]
+    return frame
+
+
+def zero_length_roots(params: Params, variables: tuple[str, ...]) -> pd.DataFrame:
+    """The d = 0 artefacts at `params` in closed form, complex ones included.
+
+    For a spring i with L0i > 0: P4 = L3 (c1, s1) on the unit circle with |a - P4| = |q| (a, q:
+    the spring's anchors in frames B and T), then R(gamma2) q = a - P4 gives (c2, s2); d_i = 0 and
+    the other spring's d_j = +-sqrt(|P_j|^2) (complex square root of the sum of squares). Each is
+    a double root of the multiplied-through system (two paths end there).
+    """
+    rows = []
+    anchors = {
+        1: ((params.p2x, 0.0), (params.p6x, 0.0)),
+        2: ((params.p3x, params.p3y), (params.p5x, params.p5y)),
+    }
+    for i in (1, 2):
+        if f"d{i}" not in variables:
+            continue
+        a, q = (np.array(v, dtype=complex) for v in anchors[i])
+        na_ = np.sqrt(a @ a)
+        e = a / na_
+        e_perp = np.array([-e[1], e[0]])
+        alpha = ((a @ a) + params.L3**2 - q @ q) / (2 * params.L3 * na_)
+        for beta in (np.sqrt(1 - alpha**2 + 0j), -np.sqrt(1 - alpha**2 + 0j)):
+            u = alpha * e + beta * e_perp
+            w = a - params.L3 * u
+            c2 = (q @ w) / (q @ q)
+            s2 = (q[0] * w[1] - q[1] * w[0]) / (q @ q)
+            point = {"c1": u[0], "s1": u[1], "c2": c2, "s2": s2, f"d{i}": 0j}
+            j = 3 - i
+            if f"d{j}" in variables:
+                vec = spring_vectors_cs(params, u[0], u[1], c2, s2)[f"spring{j}"]
+                dj = np.sqrt(vec @ vec)
+                for sign in (1, -1):
+                    rows.append({**point, f"d{j}": sign * dj})
+            else:
+                rows.append(point)
+    frame = pd.DataFrame(
+        {
+            "path_number": -1,
+            "condition_number": np.inf,
+            "function_residual": 0.0,
+            "newton_residual": 0.0,
+            "final_t": 0.0,
+            "max_precision": np.nan,
+            "accuracy_estimate": 0.0,
+            "cycle_number": 1,
+            "bertini_multiplicity": 2,
+        },
+        index=range(len(rows)),
+    )
+    for v in variables:
+        frame[v] = np.array([r[v] for r in rows], dtype=complex)
+    return frame

@@ -1,0 +1,277 @@
+"""Batch parameter sweeps: every point by parameter homotopy, in parallel, resumable.
+
+Each point's rows are written to `points/NNNNN.csv` atomically as soon as the point is solved, so a
+killed sweep loses at most the points in flight and never writes a partial or duplicate row; a
+rerun skips the points whose file exists. `sweep.csv` is assembled from them at the end.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import time
+from collections.abc import Callable, Iterable
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .geometry import PARAM_NAMES, ParameterError, Params
+from .results import write_csv, write_json
+
+SPEC_FILE = "sweep.json"
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    """What to sweep: one or two parameters over ranges, the rest fixed, and the solver seed."""
+
+    base: dict[str, float]
+    param: str
+    start: float
+    stop: float
+    points: int
+    param2: str | None = None
+    start2: float | None = None
+    stop2: float | None = None
+    points2: int | None = None
+    seed: int = 1
+
+    def __post_init__(self) -> None:
+        for name in (self.param, self.param2):
+            if name is not None and name not in PARAM_NAMES:
+                raise ParameterError(f"--param {name!r}: unknown parameter "
+                                     f"(known: {' '.join(PARAM_NAMES)})")
+        if self.points < 1:
+            raise ParameterError(f"--points {self.points}: must be at least 1")
+        if self.param2 is not None:
+            if None in (self.start2, self.stop2, self.points2) or self.points2 < 1:
+                raise ParameterError("--param2 needs --from2, --to2 and --points2 >= 1")
+            if self.param2 == self.param:
+                raise ParameterError(f"--param2 {self.param2!r}: same as --param")
+
+    @property
+    def columns(self) -> list[str]:
+        """The swept parameters' names, in order."""
+        return [self.param] + ([self.param2] if self.param2 else [])
+
+    def grid(self) -> list[dict[str, float]]:
+        """Every point's swept values, point index = list index (param2 varies fastest)."""
+        a = np.linspace(self.start, self.stop, self.points)
+        if self.param2 is None:
+            return [{self.param: float(v)} for v in a]
+        b = np.linspace(self.start2, self.stop2, self.points2)
+        return [{self.param: float(u), self.param2: float(w)} for u in a for w in b]
+
+    def key(self) -> str:
+        """Content hash: the same request maps to the same folder (and so resumes)."""
+        from . import __version__
+
+        blob = json.dumps({**asdict(self), "version": __version__}, sort_keys=True)
+        return hashlib.sha256(blob.encode()).hexdigest()[:10]
+
+    def folder_name(self) -> str:
+        """A readable, unique folder name."""
+        rng = f"{self.param}-{self.start:g}-{self.stop:g}-{self.points}"
+        if self.param2:
+            rng += f"-{self.param2}-{self.start2:g}-{self.stop2:g}-{self.points2}"
+        return f"sweep-{rng}-{self.key()}"
+
+
+@dataclass
+class PointResult:
+    """One solved point: its rows and how they were obtained."""
+
+    index: int
+    rows: pd.DataFrame
+    info: dict = field(default_factory=dict)
+
+
+def solve_point(base: dict[str, float], values: dict[str, float], seed: int,
+                threads: int | None = 1) -> pd.DataFrame:
+    """All finite solutions at one point, classified, with how they were obtained.
+
+    Parameter homotopy from the cached generic set. If a path is lost or fewer finite endpoints
+    arrive than the generic count, the point is tracked again from a second, independent generic
+    set (a new random start, like Paramotopy's new gamma); if the two disagree, it is solved ab
+    initio. The columns `method` and `lost_paths` say what happened.
+    """
+    from .equations import parametric_system
+    from .homotopy import generic_set, track, zero_length_roots
+    from .stability import classify
+
+    params = Params(**{**base, **values})
+    ps = parametric_system(params.zfl)
+    gs = generic_set(ps, seed)
+    endpoints, rep = track(ps, gs, params, threads=threads)
+    method = "parameter homotopy" + (" + adaptive retrack" if rep.retracked_adaptive else "")
+    if rep.lost or rep.finite < len(gs.points):
+        gs2 = generic_set(ps, seed + 7919)
+        endpoints2, rep2 = track(ps, gs2, params, threads=threads)
+        if rep2.lost == 0 and not rep.lost and rep2.finite == rep.finite:
+            method += "; finite count confirmed from a second start"
+        elif rep2.lost == 0 and rep2.finite >= rep.finite:
+            endpoints, rep = endpoints2, rep2
+            method = "parameter homotopy from a second start (first lost paths)"
+        else:
+            endpoints = _ab_initio(params, ps, seed)
+            method = "ab initio (both parameter homotopies lost paths)"
+    allpoints = pd.concat([endpoints, zero_length_roots(params, ps.variables)],
+                          ignore_index=True)
+    table = classify(params, ps.instantiate([getattr(params, n) for n in ps.parameters]),
+                     allpoints, ps.variables)
+    table.insert(0, "point", -1)
+    for k, name in enumerate(values):
+        table.insert(1 + k, name, values[name])
+    table["method"] = method
+    table["lost_paths"] = rep.lost
+    return table
+
+
+def _ab_initio(params: Params, ps, seed: int) -> pd.DataFrame:
+    """Total-degree solve at the target itself (in-process), as the last resort."""
+    import bertini
+    from bertini import nag_algorithm as na
+
+    from .homotopy import _frame, _points, m_singular  # noqa: F401 - shared helpers
+    from .render import render_system
+
+    bertini.recording(False)
+    bertini.random.set_random_seed(seed)
+    system = ps.instantiate([getattr(params, n) for n in ps.parameters])
+    solver = na.ZeroDimSolver(bertini.parse.system(render_system(system)))
+    solver.solve(show_progress=False)
+    rows = []
+    for i, (m, p) in enumerate(zip(solver.solution_metadata(), solver.all_solutions(),
+                                   strict=True)):
+        if not m.is_finite or str(m.endgame_success_code).rsplit(".", 1)[-1] != "Success":
+            continue
+        d = m.to_dict()
+        rows.append({"path_number": i, "condition_number": float(d["condition_number"]),
+                     "function_residual": float(d["function_residual"]),
+                     "newton_residual": float(d["newton_residual"]),
+                     "final_t": complex(d["final_time_used"]).real,
+                     "max_precision": float(d["max_precision_used"]),
+                     "accuracy_estimate": float(d["accuracy_estimate_user_coords"]),
+                     "cycle_number": int(d["cycle_num"]),
+                     "bertini_multiplicity": int(d["multiplicity"]),
+                     "coords": [complex(z) for z in p]})
+    # Singular endpoints are reported by the closed form, not twice.
+    frame = _frame(ps.variables, rows)
+    return frame[frame["bertini_multiplicity"] <= 1].reset_index(drop=True)
+
+
+def _point_task(args: tuple) -> tuple[int, pd.DataFrame, float]:
+    index, base, values, seed = args
+    start = time.perf_counter()
+    table = solve_point(base, values, seed, threads=1)
+    table["point"] = index
+    return index, table, time.perf_counter() - start
+
+
+def _point_file(folder: Path, index: int) -> Path:
+    return folder / "points" / f"{index:05d}.csv"
+
+
+def pending_points(spec: SweepSpec, folder: Path) -> list[int]:
+    """Indices of the grid points that have no finished point file yet."""
+    return [i for i in range(len(spec.grid())) if not _point_file(folder, i).is_file()]
+
+
+def prepare(spec: SweepSpec, root: Path, resume: Path | None = None) -> Path:
+    """The sweep folder: `resume` (checked against spec), or root/<name> for this request."""
+    folder = resume if resume is not None else root / spec.folder_name()
+    spec_path = folder / SPEC_FILE
+    if spec_path.is_file():
+        saved = json.loads(spec_path.read_text())
+        if resume is None and saved.get("spec") != asdict(spec):
+            raise ParameterError(f"{folder}: holds a different sweep; use another --out")
+    else:
+        if resume is not None:
+            raise ParameterError(f"--resume {str(resume)!r}: no {SPEC_FILE} there")
+        (folder / "points").mkdir(parents=True, exist_ok=True)
+        write_json(spec_path, {"spec": asdict(spec), "key": spec.key()})
+    (folder / "points").mkdir(parents=True, exist_ok=True)
+    return folder
+
+
+def load_spec(folder: Path) -> SweepSpec:
+    """The spec a sweep folder was made for."""
+    path = folder / SPEC_FILE
+    if not path.is_file():
+        raise ParameterError(f"--resume {str(folder)!r}: no {SPEC_FILE} there")
+    return SweepSpec(**json.loads(path.read_text())["spec"])
+
+
+def warm_generic_sets(spec: SweepSpec) -> None:
+    """Solve (or load) the generic sets every point needs, once, before workers start."""
+    from .equations import parametric_system
+    from .homotopy import generic_set
+
+    structures = {Params(**{**spec.base, **v}).zfl for v in spec.grid()}
+    for zfl in sorted(structures):
+        generic_set(parametric_system(zfl), spec.seed)
+
+
+def run_points(spec: SweepSpec, folder: Path, workers: int = 1, scheduler: str | None = None,
+               progress: Callable[[int, int, int], None] | None = None) -> dict:
+    """Solve every pending point (local processes, or a Dask cluster) and store each atomically."""
+    grid = spec.grid()
+    todo = pending_points(spec, folder)
+    tasks = [(i, spec.base, grid[i], spec.seed) for i in todo]
+    stats = {"points": len(grid), "skipped": len(grid) - len(todo), "solved": 0,
+             "lost_paths": 0, "seconds": 0.0}
+    if not tasks:
+        return stats
+    warm_generic_sets(spec)
+    start = time.perf_counter()
+    for index, table, _ in _execute(tasks, workers, scheduler):
+        write_csv(_point_file(folder, index), table)
+        stats["solved"] += 1
+        stats["lost_paths"] += int(table["lost_paths"].max()) if len(table) else 0
+        if progress:
+            progress(stats["solved"], len(tasks), stats["lost_paths"])
+    stats["seconds"] = time.perf_counter() - start
+    return stats
+
+
+def _execute(tasks: list[tuple], workers: int, scheduler: str | None) -> Iterable[tuple]:
+    if scheduler is not None:
+        from distributed import Client, as_completed
+
+        with Client(scheduler) as client:
+            futures = client.map(_point_task, tasks, pure=False)
+            for fut in as_completed(futures):
+                yield fut.result()
+        return
+    if workers <= 1:
+        for t in tasks:
+            yield _point_task(t)
+        return
+    import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+
+    ctx = mp.get_context("spawn")  # the bertini module is not fork-safe with its threads
+    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+        futures = [pool.submit(_point_task, t) for t in tasks]
+        for fut in as_completed(futures):
+            yield fut.result()
+
+
+def assemble(spec: SweepSpec, folder: Path) -> pd.DataFrame:
+    """All point files as one table, in grid order (errors if a point is missing)."""
+    missing = pending_points(spec, folder)
+    if missing:
+        raise RuntimeError(f"{folder}: {len(missing)} points not solved yet (first {missing[0]})")
+    frames = [pd.read_csv(_point_file(folder, i), keep_default_na=True)
+              for i in range(len(spec.grid()))]
+    table = pd.concat(frames, ignore_index=True)
+    return table
+
+
+def default_workers() -> int:
+    """One worker per core."""
+    return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
+               else os.cpu_count() or 1)

@@ -71,6 +71,25 @@ def _parser() -> argparse.ArgumentParser:
     v.add_argument("--threads", type=int, default=None)
     v.add_argument("--mptype", type=int, default=2, choices=(0, 1, 2))
     v.add_argument("--bertini", metavar="PATH")
+    w = sub.add_parser("sweep", help="solve along a parameter range (or a 2-D grid)")
+    w.add_argument("--param", default="L01", help="swept parameter (default L01)")
+    w.add_argument("--from", dest="start", type=float, default=0.0)
+    w.add_argument("--to", dest="stop", type=float, default=12.0)
+    w.add_argument("--points", type=int, default=241)
+    w.add_argument("--param2", help="a second swept parameter: a 2-D grid")
+    w.add_argument("--from2", dest="start2", type=float)
+    w.add_argument("--to2", dest="stop2", type=float)
+    w.add_argument("--points2", type=int)
+    w.add_argument("--params", metavar="FILE.toml", help="base parameters (default Table 1)")
+    w.add_argument("--set", action="append", default=[], metavar="NAME=VALUE")
+    w.add_argument("--seed", type=int, default=1)
+    w.add_argument("--workers", type=int, default=None, help="local processes (default: cores)")
+    w.add_argument("--scheduler", metavar="ADDRESS", help="a Dask scheduler, tcp://host:8786")
+    w.add_argument("--out", metavar="DIR", default="runs", help="root of sweep folders")
+    w.add_argument("--resume", metavar="DIR", help="continue the sweep in DIR")
+    w.add_argument("--all", action="store_true", help="plot non-physical real roots too")
+    w.add_argument("--no-plots", action="store_true", help="skip the figures")
+    w.add_argument("--quiet", action="store_true", help="no progress bar")
     pp = sub.add_parser("paper", help="compare Tables 2-4 of the paper with our solutions")
     pp.add_argument("--out", metavar="DIR", default="runs/paper", help="default runs/paper")
     pp.add_argument("--seed", type=int, default=1, help="Bertini RandomSeed (default 1)")
@@ -140,6 +159,82 @@ def _verify(args: argparse.Namespace) -> int:
     bad = [r.route for r in results if r.agrees is False]
     print("all routes agree" if not bad else f"disagreement: {', '.join(bad)}")
     return 1 if bad else 0
+
+
+def _sweep(args: argparse.Namespace) -> int:
+    from .sweep import (
+        SweepSpec,
+        default_workers,
+        finish,
+        load_spec,
+        prepare,
+        run_points,
+    )
+    from .sweep import (
+        pending_points as pending,
+    )
+
+    if args.resume:
+        spec = load_spec(Path(args.resume))
+        folder = prepare(spec, Path(args.out), resume=Path(args.resume))
+    else:
+        overrides: dict[str, float] = {}
+        if args.params:
+            overrides.update(load_toml(args.params))
+        for text in args.set:
+            name, value = parse_assignment(text)
+            overrides[name] = value
+        base = make_params(None, overrides).as_dict()
+        spec = SweepSpec(
+            base,
+            args.param,
+            args.start,
+            args.stop,
+            args.points,
+            args.param2,
+            args.start2,
+            args.stop2,
+            args.points2,
+            args.seed,
+        )
+        for values in (spec.grid()[0], spec.grid()[-1]):
+            make_params(None, {**base, **values})  # a bad range fails here, before any work
+        folder = prepare(spec, Path(args.out))
+    workers = args.workers or default_workers()
+    bar = None
+    if not args.quiet:
+        from tqdm import tqdm
+
+        bar = tqdm(total=len(spec.grid()), unit="pt", desc="sweep", file=sys.stderr)
+        bar.update(len(spec.grid()) - len(pending(spec, folder)))
+
+    def progress(done: int, total: int, lost: int) -> None:
+        if bar is not None:
+            bar.update(1)
+            bar.set_postfix(lost_paths=lost)
+
+    stats = run_points(spec, folder, workers=workers, scheduler=args.scheduler, progress=progress)
+    if bar is not None:
+        bar.close()
+    record = finish(
+        spec,
+        folder,
+        stats,
+        plots=not args.no_plots,
+        show_all=args.all,
+        workers=workers,
+        scheduler=args.scheduler,
+        command=sys.argv[:],
+    )
+    print(
+        f"{record['rows']} rows at {record['points']} points ({stats['skipped']} resumed), "
+        f"{record['events']} events, {stats['seconds']:.1f} s solving"
+    )
+    print(
+        f"files: {folder}/sweep.csv, events.csv, run.json"
+        + (", " + ", ".join(record["figures"]) if record["figures"] else "")
+    )
+    return 0
 
 
 def _params(args: argparse.Namespace):
@@ -219,6 +314,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if args.command == "solve":
             return _solve(args)
+        if args.command == "sweep":
+            return _sweep(args)
         if args.command == "verify":
             return _verify(args)
         if args.command == "paper":

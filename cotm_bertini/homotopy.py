@@ -242,21 +242,7 @@ def track(
         m, p = results[i]
         code = _code(m)
         if code == _SUCCESS and m.is_finite:
-            d = m.to_dict()
-            rows.append(
-                {
-                    "path_number": i,
-                    "condition_number": float(d["condition_number"]),
-                    "function_residual": float(d["function_residual"]),
-                    "newton_residual": float(d["newton_residual"]),
-                    "final_t": complex(d["final_time_used"]).real,
-                    "max_precision": float(d["max_precision_used"]),
-                    "accuracy_estimate": float(d["accuracy_estimate_user_coords"]),
-                    "cycle_number": int(d["cycle_num"]),
-                    "bertini_multiplicity": int(d["multiplicity"]),
-                    "coords": [complex(z) for z in p],
-                }
-            )
+            rows.append(_row(i, m, p))
         elif code in ("GoingToInfinity", "SecurityMaxNormReached") or not m.is_finite:
             rep.infinite += 1
         else:
@@ -265,6 +251,23 @@ def track(
     rep.finite = len(rows)
     rep.seconds = time.perf_counter() - t0
     return _frame(ps.variables, rows), rep
+
+
+def _row(index: int, m, point) -> dict:
+    """One endpoint's metadata (parse.METADATA_COLUMNS) and coordinates."""
+    d = m.to_dict()
+    return {
+        "path_number": index,
+        "condition_number": float(d["condition_number"]),
+        "function_residual": float(d["function_residual"]),
+        "newton_residual": float(d["newton_residual"]),
+        "final_t": complex(d["final_time_used"]).real,
+        "max_precision": float(d["max_precision_used"]),
+        "accuracy_estimate": float(d["accuracy_estimate_user_coords"]),
+        "cycle_number": int(d["cycle_num"]),
+        "bertini_multiplicity": int(d["multiplicity"]),
+        "coords": [complex(z) for z in point],
+    }
 
 
 def _crossing(results: dict, idx: list[int], tol: float = 1e-7) -> bool:
@@ -345,3 +348,60 @@ def zero_length_roots(params: Params, variables: tuple[str, ...]) -> pd.DataFram
     for v in variables:
         frame[v] = np.array([r[v] for r in rows], dtype=complex)
     return frame
+
+
+def solve_target(
+    ps: ParametricSystem, params: Params, seed: int = 1, threads: int | None = None
+) -> tuple[pd.DataFrame, dict]:
+    """Every finite endpoint at `params` (tracked ones plus the closed-form d = 0 artefacts).
+
+    Parameter homotopy from the cached generic set. If a path is lost, or fewer finite endpoints
+    arrive than the generic count, the point is tracked again from a second, independent generic
+    set (a new random start, like Paramotopy's new gamma); if that does not settle it, the target
+    is solved ab initio. `info["method"]` says which, `info["lost"]` how many paths were lost.
+    """
+    gs = generic_set(ps, seed)
+    endpoints, rep = track(ps, gs, params, threads=threads)
+    method = "parameter homotopy" + (" + adaptive retrack" if rep.retracked_adaptive else "")
+    if rep.lost or rep.finite < len(gs.points):
+        gs2 = generic_set(ps, seed + 7919)
+        endpoints2, rep2 = track(ps, gs2, params, threads=threads)
+        if rep2.lost == 0 and not rep.lost and rep2.finite == rep.finite:
+            method += "; finite count confirmed from a second start"
+        elif rep2.lost == 0 and rep2.finite >= rep.finite:
+            endpoints, rep = endpoints2, rep2
+            method = "parameter homotopy from a second start (the first lost paths)"
+        else:
+            endpoints = ab_initio(ps, params, seed)
+            method = "ab initio (both parameter homotopies lost paths)"
+    info = {
+        **rep.as_dict(),
+        "method": method,
+        "generic_key": gs.key,
+        "generic_paths": gs.paths,
+        "generic_finite": gs.finite_endpoints,
+    }
+    allpoints = pd.concat([endpoints, zero_length_roots(params, ps.variables)], ignore_index=True)
+    return allpoints, info
+
+
+def ab_initio(ps: ParametricSystem, params: Params, seed: int) -> pd.DataFrame:
+    """Total-degree solve at the target itself (in-process): the last resort.
+
+    Its singular endpoints (the d = 0 artefacts) are dropped: the closed form reports them.
+    """
+    bertini = _bertini()
+    from bertini import nag_algorithm as na
+
+    bertini.random.set_random_seed(seed)
+    system = ps.instantiate([getattr(params, n) for n in ps.parameters])
+    solver = na.ZeroDimSolver(bertini.parse.system(render_system(system)))
+    solver.solve(show_progress=False)
+    rows = [
+        _row(i, m, p)
+        for i, (m, p) in enumerate(
+            zip(solver.solution_metadata(), solver.all_solutions(), strict=True)
+        )
+        if m.is_finite and _code(m) == _SUCCESS and not m_singular(m)
+    ]
+    return _frame(ps.variables, rows)

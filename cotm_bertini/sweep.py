@@ -42,8 +42,9 @@ class SweepSpec:
     def __post_init__(self) -> None:
         for name in (self.param, self.param2):
             if name is not None and name not in PARAM_NAMES:
-                raise ParameterError(f"--param {name!r}: unknown parameter "
-                                     f"(known: {' '.join(PARAM_NAMES)})")
+                raise ParameterError(
+                    f"--param {name!r}: unknown parameter (known: {' '.join(PARAM_NAMES)})"
+                )
         if self.points < 1:
             raise ParameterError(f"--points {self.points}: must be at least 1")
         if self.param2 is not None:
@@ -89,78 +90,26 @@ class PointResult:
     info: dict = field(default_factory=dict)
 
 
-def solve_point(base: dict[str, float], values: dict[str, float], seed: int,
-                threads: int | None = 1) -> pd.DataFrame:
-    """All finite solutions at one point, classified, with how they were obtained.
-
-    Parameter homotopy from the cached generic set. If a path is lost or fewer finite endpoints
-    arrive than the generic count, the point is tracked again from a second, independent generic
-    set (a new random start, like Paramotopy's new gamma); if the two disagree, it is solved ab
-    initio. The columns `method` and `lost_paths` say what happened.
-    """
+def solve_point(
+    base: dict[str, float], values: dict[str, float], seed: int, threads: int | None = 1
+) -> pd.DataFrame:
+    """All finite solutions at one point, classified, with how they were obtained."""
     from .equations import parametric_system
-    from .homotopy import generic_set, track, zero_length_roots
+    from .homotopy import solve_target
     from .stability import classify
 
     params = Params(**{**base, **values})
     ps = parametric_system(params.zfl)
-    gs = generic_set(ps, seed)
-    endpoints, rep = track(ps, gs, params, threads=threads)
-    method = "parameter homotopy" + (" + adaptive retrack" if rep.retracked_adaptive else "")
-    if rep.lost or rep.finite < len(gs.points):
-        gs2 = generic_set(ps, seed + 7919)
-        endpoints2, rep2 = track(ps, gs2, params, threads=threads)
-        if rep2.lost == 0 and not rep.lost and rep2.finite == rep.finite:
-            method += "; finite count confirmed from a second start"
-        elif rep2.lost == 0 and rep2.finite >= rep.finite:
-            endpoints, rep = endpoints2, rep2
-            method = "parameter homotopy from a second start (first lost paths)"
-        else:
-            endpoints = _ab_initio(params, ps, seed)
-            method = "ab initio (both parameter homotopies lost paths)"
-    allpoints = pd.concat([endpoints, zero_length_roots(params, ps.variables)],
-                          ignore_index=True)
-    table = classify(params, ps.instantiate([getattr(params, n) for n in ps.parameters]),
-                     allpoints, ps.variables)
+    endpoints, info = solve_target(ps, params, seed, threads=threads)
+    table = classify(
+        params, ps.instantiate([getattr(params, n) for n in ps.parameters]), endpoints, ps.variables
+    )
     table.insert(0, "point", -1)
     for k, name in enumerate(values):
         table.insert(1 + k, name, values[name])
-    table["method"] = method
-    table["lost_paths"] = rep.lost
+    table["method"] = info["method"]
+    table["lost_paths"] = info["lost"]
     return table
-
-
-def _ab_initio(params: Params, ps, seed: int) -> pd.DataFrame:
-    """Total-degree solve at the target itself (in-process), as the last resort."""
-    import bertini
-    from bertini import nag_algorithm as na
-
-    from .homotopy import _frame, _points, m_singular  # noqa: F401 - shared helpers
-    from .render import render_system
-
-    bertini.recording(False)
-    bertini.random.set_random_seed(seed)
-    system = ps.instantiate([getattr(params, n) for n in ps.parameters])
-    solver = na.ZeroDimSolver(bertini.parse.system(render_system(system)))
-    solver.solve(show_progress=False)
-    rows = []
-    for i, (m, p) in enumerate(zip(solver.solution_metadata(), solver.all_solutions(),
-                                   strict=True)):
-        if not m.is_finite or str(m.endgame_success_code).rsplit(".", 1)[-1] != "Success":
-            continue
-        d = m.to_dict()
-        rows.append({"path_number": i, "condition_number": float(d["condition_number"]),
-                     "function_residual": float(d["function_residual"]),
-                     "newton_residual": float(d["newton_residual"]),
-                     "final_t": complex(d["final_time_used"]).real,
-                     "max_precision": float(d["max_precision_used"]),
-                     "accuracy_estimate": float(d["accuracy_estimate_user_coords"]),
-                     "cycle_number": int(d["cycle_num"]),
-                     "bertini_multiplicity": int(d["multiplicity"]),
-                     "coords": [complex(z) for z in p]})
-    # Singular endpoints are reported by the closed form, not twice.
-    frame = _frame(ps.variables, rows)
-    return frame[frame["bertini_multiplicity"] <= 1].reset_index(drop=True)
 
 
 def _point_task(args: tuple) -> tuple[int, pd.DataFrame, float]:
@@ -215,14 +164,24 @@ def warm_generic_sets(spec: SweepSpec) -> None:
         generic_set(parametric_system(zfl), spec.seed)
 
 
-def run_points(spec: SweepSpec, folder: Path, workers: int = 1, scheduler: str | None = None,
-               progress: Callable[[int, int, int], None] | None = None) -> dict:
+def run_points(
+    spec: SweepSpec,
+    folder: Path,
+    workers: int = 1,
+    scheduler: str | None = None,
+    progress: Callable[[int, int, int], None] | None = None,
+) -> dict:
     """Solve every pending point (local processes, or a Dask cluster) and store each atomically."""
     grid = spec.grid()
     todo = pending_points(spec, folder)
     tasks = [(i, spec.base, grid[i], spec.seed) for i in todo]
-    stats = {"points": len(grid), "skipped": len(grid) - len(todo), "solved": 0,
-             "lost_paths": 0, "seconds": 0.0}
+    stats = {
+        "points": len(grid),
+        "skipped": len(grid) - len(todo),
+        "solved": 0,
+        "lost_paths": 0,
+        "seconds": 0.0,
+    }
     if not tasks:
         return stats
     warm_generic_sets(spec)
@@ -265,13 +224,69 @@ def assemble(spec: SweepSpec, folder: Path) -> pd.DataFrame:
     missing = pending_points(spec, folder)
     if missing:
         raise RuntimeError(f"{folder}: {len(missing)} points not solved yet (first {missing[0]})")
-    frames = [pd.read_csv(_point_file(folder, i), keep_default_na=True)
-              for i in range(len(spec.grid()))]
+    frames = [
+        pd.read_csv(_point_file(folder, i), keep_default_na=True) for i in range(len(spec.grid()))
+    ]
     table = pd.concat(frames, ignore_index=True)
     return table
 
 
 def default_workers() -> int:
     """One worker per core."""
-    return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
-               else os.cpu_count() or 1)
+    return max(
+        1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+    )
+
+
+def finish(
+    spec: SweepSpec,
+    folder: Path,
+    stats: dict,
+    plots: bool = True,
+    show_all: bool = False,
+    workers: int = 1,
+    scheduler: str | None = None,
+    command: list[str] | None = None,
+) -> dict:
+    """Assemble sweep.csv (with branches for 1-D sweeps), events.csv, figures and run.json."""
+    from . import engine
+
+    t0 = time.perf_counter()
+    table = assemble(spec, folder)
+    events = pd.DataFrame(columns=["kind", "branches", "value", "gamma1_deg", "gamma2_deg"])
+    if spec.param2 is None:
+        from .branches import assign_branches, find_events
+
+        table = assign_branches(table, spec.param)
+        events = find_events(table, spec.param, Params(**spec.base), spec.seed)
+    write_csv(folder / "sweep.csv", table)
+    write_csv(folder / "events.csv", events)
+    figures: list[str] = []
+    if plots:
+        from .plot import plot_bifurcation, plot_sweep_counts
+
+        if spec.param2 is None:
+            paths = plot_bifurcation(
+                table, spec.param, folder / "bifurcation", show_all=show_all, events=events
+            )
+        else:
+            paths = plot_sweep_counts(table, spec.columns, folder / "counts")
+        figures = [p.name for p in paths]
+    record = {
+        "spec": asdict(spec),
+        "key": spec.key(),
+        "command": command,
+        "points": len(spec.grid()),
+        "rows": len(table),
+        "events": len(events),
+        "stats": stats,
+        "workers": workers,
+        "scheduler": scheduler,
+        "methods": table["method"].value_counts().to_dict() if len(table) else {},
+        "lost_paths": int(table["lost_paths"].sum()) if len(table) else 0,
+        "versions": engine.python_versions(),
+        "figures": figures,
+        "timings": {"solve": stats["seconds"], "finish": time.perf_counter() - t0},
+    }
+    write_json(folder / "run.json", record)
+    return record

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import tempfile
 from pathlib import Path
@@ -59,6 +60,12 @@ def _parser() -> argparse.ArgumentParser:
         help="a Bertini 1.x binary instead of bertini2 (also $COTM_BERTINI)",
     )
     s.add_argument(
+        "--engine",
+        choices=("homotopy", "cli"),
+        help="homotopy: parameter homotopy in-process from the cached generic solution set "
+        "(default); cli: total-degree solve by the bertini2 command (or --bertini)",
+    )
+    s.add_argument(
         "--no-plots", action="store_true", help="skip the figures (and the import of matplotlib)"
     )
     s.add_argument("--quiet", action="store_true", help="print only where the files are")
@@ -71,6 +78,7 @@ def _parser() -> argparse.ArgumentParser:
     v.add_argument("--threads", type=int, default=None)
     v.add_argument("--mptype", type=int, default=2, choices=(0, 1, 2))
     v.add_argument("--bertini", metavar="PATH")
+    v.add_argument("--engine", choices=("homotopy", "cli"))
     w = sub.add_parser("sweep", help="solve along a parameter range (or a 2-D grid)")
     w.add_argument("--param", default="L01", help="swept parameter (default L01)")
     w.add_argument("--from", dest="start", type=float, default=0.0)
@@ -130,13 +138,7 @@ def _verify(args: argparse.Namespace) -> int:
     from .verify import verify
 
     params = _params(args)
-    settings = Settings(
-        seed=args.seed,
-        timeout=args.timeout,
-        threads=args.threads,
-        mptype=args.mptype,
-        bertini=args.bertini,
-    )
+    settings = _settings(args)
     solutions = solve(params, settings)
     phys = int(solutions["physical"].sum())
     print(
@@ -237,6 +239,21 @@ def _sweep(args: argparse.Namespace) -> int:
     return 0
 
 
+def _settings(args: argparse.Namespace) -> Settings:
+    """Settings from the command line; a Bertini binary (--bertini, $COTM_BERTINI) means cli."""
+    engine = args.engine or (
+        "cli" if (args.bertini or os.environ.get("COTM_BERTINI")) else "homotopy"
+    )
+    return Settings(
+        seed=args.seed,
+        timeout=args.timeout,
+        threads=args.threads,
+        mptype=args.mptype,
+        bertini=args.bertini,
+        engine=engine,
+    )
+
+
 def _params(args: argparse.Namespace):
     overrides: dict[str, float] = {}
     if args.params:
@@ -281,13 +298,7 @@ def _solve(args: argparse.Namespace) -> int:
     from .pipeline import run_and_record
 
     params = _params(args)
-    settings = Settings(
-        seed=args.seed,
-        timeout=args.timeout,
-        threads=args.threads,
-        mptype=args.mptype,
-        bertini=args.bertini,
-    )
+    settings = _settings(args)
     root = Path(args.out) if args.out else Path("runs") / args.case
     folder, solved, record = run_and_record(
         params, settings, root, args.case, command=sys.argv[:], plots=not args.no_plots

@@ -52,6 +52,7 @@ class Solved:
     bertini_seconds: float
     paths_tracked: int | None
     timings: dict[str, float]
+    details: dict = field(default_factory=dict)
 
 
 def solve_in(
@@ -61,7 +62,13 @@ def solve_in(
     tolerances: Tolerances = Tolerances(),
     title: str = "",
 ) -> Solved:
-    """Solve `params` with Bertini in the empty `folder` (kept with Bertini's files)."""
+    """Solve `params` in the empty `folder`: the input file(s) and Bertini's files are kept.
+
+    Engine "homotopy" (default): parameter homotopy in-process from the cached generic solution
+    set. Engine "cli": a total-degree solve by the bertini2 command (or a Bertini 1.x binary).
+    """
+    if settings.engine == "homotopy":
+        return _solve_homotopy(folder, params, settings, tolerances)
     t = Timings()
     with t.stage("derive"):
         system = polynomial_system(params)
@@ -78,6 +85,57 @@ def solve_in(
     if tracked is None and settings.variable_groups == "total_degree":
         tracked = system.total_degree
     return Solved(table, system, out, text, eng, run.version, run.seconds, tracked, t.stages)
+
+
+def _solve_homotopy(
+    folder: Path, params: Params, settings: Settings, tolerances: Tolerances
+) -> Solved:
+    from .equations import parametric_system
+    from .homotopy import generic_set, solve_target
+    from .render import render_parameter_homotopy
+
+    t = Timings()
+    with t.stage("derive"):
+        ps = parametric_system(params.zfl)
+        system = ps.instantiate([getattr(params, n) for n in ps.parameters])
+    with t.stage("generic"):
+        gs = generic_set(ps, settings.seed)
+    with t.stage("render"):
+        folder.mkdir(parents=True, exist_ok=True)
+        target = {n: getattr(params, n) for n in ps.parameters}
+        text = render_parameter_homotopy(ps, gs.start, target)
+        (folder / "input").write_text(text)
+    with t.stage("solve"):
+        endpoints, info = solve_target(ps, params, settings.seed, threads=settings.threads)
+    with t.stage("classify"):
+        table = classify(params, system, endpoints, ps.variables, tolerances)
+    out = BertiniOutput("in-process", ps.variables, endpoints, len(endpoints), None)
+    eng = engine_mod.Engine("bertini module (in-process)", "homotopy", gs.bertini_version, {})
+    details = {
+        "homotopy": info,
+        "generic_set": {
+            "key": gs.key,
+            "seed": gs.seed,
+            "paths": gs.paths,
+            "finite_endpoints": gs.finite_endpoints,
+            "singular_endpoints": gs.singular_endpoints,
+            "tracked_points": len(gs.points),
+            "solve_seconds": gs.seconds,
+            "start_parameters": {k: [v.real, v.imag] for k, v in gs.start.items()},
+        },
+    }
+    return Solved(
+        table,
+        system,
+        out,
+        text,
+        eng,
+        gs.bertini_version,
+        t.stages["solve"],
+        info["tracked"],
+        t.stages,
+        details,
+    )
 
 
 def solve(
@@ -176,6 +234,7 @@ def run_and_record(
             "version": solved.bertini_version,
         },
         output_layout=solved.output.layout,
+        details=solved.details,
         polynomial_system={
             "variables": list(solved.system.variables),
             "functions": list(solved.system.names),

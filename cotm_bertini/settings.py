@@ -31,6 +31,7 @@ class Settings:
     condnum_threshold: float | None = None
     max_norm: float | None = None
     variable_groups: str = "total_degree"  # or "multihomogeneous"
+    engine: str = "homotopy"  # or "cli": a total-degree solve by the bertini2 / Bertini 1 binary
     timeout: float = 600.0
     threads: int | None = None  # None: Bertini 2 uses every core
     bertini: str | None = None  # path of a Bertini 1.x binary; None: bundled bertini2
@@ -43,6 +44,10 @@ class Settings:
             raise ValueError(f"seed = {self.seed!r}: expected an integer in [0, 2^31)")
         if self.timeout <= 0:
             raise ValueError(f"timeout = {self.timeout!r}: must be > 0 seconds")
+        if self.engine not in ("homotopy", "cli"):
+            raise ValueError(f"engine = {self.engine!r}: expected 'homotopy' or 'cli'")
+        if self.bertini is not None and self.engine != "cli":
+            object.__setattr__(self, "engine", "cli")  # a user's binary means the CLI route
         if self.variable_groups not in ("total_degree", "multihomogeneous"):
             raise ValueError(
                 f"variable_groups = {self.variable_groups!r}: "

@@ -24,7 +24,8 @@ def solved(case: str, k2: float | None = None):
 
     params = make_params(case, {} if k2 is None else {"k2": k2})
     folder = Path(tempfile.mkdtemp(prefix=f"cotm-test-{case}-")) / "run"
-    return solve_in(folder, params, Settings(seed=7)), params
+    # The CLI route: an ab-initio total-degree solve by bertini2, independent of the homotopy.
+    return solve_in(folder, params, Settings(seed=7, engine="cli")), params
 
 
 @pytest.fixture(scope="session")

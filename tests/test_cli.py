@@ -41,7 +41,7 @@ def cli(*args: str, env: dict | None = None, cwd: Path | None = None):
 
 def test_solve_case1_writes_run_folder(tmp_path):
     """solve case1: exit 0, one run folder with solutions.csv, input, Bertini files, run.json."""
-    r = cli("solve", "case1", "--out", str(tmp_path), "--seed", "11")
+    r = cli("solve", "case1", "--out", str(tmp_path), "--seed", "11", "--engine", "cli")
     assert r.returncode == 0, r.stderr
     runs = [p for p in tmp_path.iterdir() if p.is_dir() and not p.is_symlink()]
     assert len(runs) == 1
@@ -72,6 +72,20 @@ def test_solve_case1_writes_run_folder(tmp_path):
     assert rec["counts"]["distinct_solutions"] == 6
     assert rec["morse"]["ok"] and rec["morse"]["euler_characteristic"] == 0
     assert not list(tmp_path.glob(".partial-*"))
+
+
+def test_default_engine_is_the_parameter_homotopy(tmp_path):
+    """Without --engine: the in-process parameter homotopy, recorded in run.json."""
+    r = cli("solve", "case2", "--out", str(tmp_path), "--no-plots", "--quiet")
+    assert r.returncode == 0, r.stderr
+    run = Path(r.stdout.strip())
+    rec = json.loads((run / "run.json").read_text())
+    assert rec["engine"]["flavour"] == "homotopy"
+    assert rec["details"]["homotopy"]["lost"] == 0
+    assert rec["details"]["generic_set"]["paths"] == 48
+    assert "pathvariable t;" in (run / "input").read_text()
+    table = pd.read_csv(run / "solutions.csv")
+    assert (len(table), table["is_real"].sum(), table["physical"].sum()) == (22, 10, 6)
 
 
 def test_params_file_and_set_override(tmp_path):

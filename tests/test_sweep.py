@@ -15,6 +15,7 @@ import pytest
 
 from cotm_bertini.geometry import TABLE1, make_params
 from cotm_bertini.pipeline import solve
+from cotm_bertini.settings import Settings
 from cotm_bertini.sweep import SweepSpec, assemble, prepare, run_points
 
 
@@ -47,7 +48,7 @@ def test_sweep_points_equal_fresh_solves(sweep21):
     spec, _, table, stats = sweep21
     assert stats["solved"] == 21 and stats["lost_paths"] == 0
     for k, values in enumerate(spec.grid()):
-        fresh = solve(make_params(None, {**TABLE1, **values}))
+        fresh = solve(make_params(None, {**TABLE1, **values}), Settings(engine="cli"))
         rows = table[table["point"] == k]
         assert len(rows) == len(fresh), values  # every finite solution, not just physical ones
         assert _same_points(_physical(rows), _physical(fresh)), values

@@ -68,6 +68,11 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument(
         "--no-plots", action="store_true", help="skip the figures (and the import of matplotlib)"
     )
+    s.add_argument(
+        "--no-cache",
+        action="store_true",
+        help="solve even if an identical request was answered before",
+    )
     s.add_argument("--quiet", action="store_true", help="print only where the files are")
     v = sub.add_parser("verify", help="cross-check a case by independent routes")
     v.add_argument("case", nargs="?", choices=sorted(CASES), default="case3")
@@ -264,16 +269,19 @@ def _params(args: argparse.Namespace):
     return make_params(args.case, overrides)
 
 
-def _print_table(solved, folder: Path, record: dict) -> None:
+def _summary(solved, folder: Path, record: dict) -> str:
+    """The console report of a solve: counts, the real solutions, where the files are."""
     s = solved.solutions
     real = s[s["is_real"]]
     c = record["counts"]
-    print(
+    engine = record["engine"]
+    lines = [
         f"{record['label']}: {c['distinct_solutions']} distinct finite solutions "
         f"({c['real']} real, {c['physical']} physical, {c['stable']} stable) "
-        f"from {c['finite_endpoints']} finite endpoints of {c['paths_tracked']} paths; "
-        f"Bertini {record['engine']['version']} {record['timings']['solve']:.2f} s"
-    )
+        f"from {c['finite_endpoints']} finite endpoints of {c['paths_tracked']} paths tracked; "
+        f"{engine['flavour']} ({engine['path']} {engine['version']}) "
+        f"{record['timings']['solve']:.2f} s"
+    ]
     if len(real):
         cols = [
             "solution_id",
@@ -286,25 +294,18 @@ def _print_table(solved, folder: Path, record: dict) -> None:
             "kind",
             "reason",
         ]
-        print(real[cols].to_string(index=False, float_format=lambda v: f"{v:.4f}"))
-    figures = ", ".join(record["figures"])
-    print(
-        f"files: {folder}/solutions.csv, run.json, input, Bertini output"
-        + (f", {figures}" if figures else "")
-    )
+        lines.append(real[cols].to_string(index=False, float_format=lambda v: f"{v:.4f}"))
+    return "\n".join(lines)
 
 
-def _solve(args: argparse.Namespace) -> int:
-    from .pipeline import run_and_record
+def _files_line(folder: Path) -> str:
+    files = sorted(p.name for p in folder.iterdir() if p.is_file())
+    return f"files in {folder}: {', '.join(files)}"
 
-    params = _params(args)
-    settings = _settings(args)
-    root = Path(args.out) if args.out else Path("runs") / args.case
-    folder, solved, record = run_and_record(
-        params, settings, root, args.case, command=sys.argv[:], plots=not args.no_plots
-    )
-    morse = record["morse"]
-    if not morse["ok"]:
+
+def _warn_morse(record: dict) -> None:
+    morse = record.get("morse") or {}
+    if morse and not morse["ok"]:
         print(
             "cotm-bertini: warning: #min - #saddle + #max (+ zero-length maxima) = "
             f"{morse['euler_characteristic']} != 0 on the torus"
@@ -312,10 +313,54 @@ def _solve(args: argparse.Namespace) -> int:
             + ": equilibria may be missing",
             file=sys.stderr,
         )
-    if args.quiet:
-        print(folder)
-    else:
-        _print_table(solved, folder, record)
+
+
+def _solve(args: argparse.Namespace) -> int:
+    import datetime as dt
+    import time
+
+    from . import cache
+    from .results import link_latest, new_run_folder, write_json
+
+    start = time.perf_counter()
+    params = _params(args)
+    settings = _settings(args)
+    root = Path(args.out) if args.out else Path("runs") / args.case
+    key = cache.request_key(params.as_dict(), settings.as_dict(), plots=not args.no_plots)
+    cached = None if args.no_cache else cache.lookup(key)
+    if cached is not None:
+        work, final = new_run_folder(root)
+        record = cache.replay(
+            key,
+            cached,
+            work,
+            final,
+            {
+                "created": dt.datetime.now().astimezone().isoformat(timespec="seconds"),
+                "command": sys.argv[:],
+            },
+        )
+        link_latest(root, final)
+        _warn_morse(record)
+        print(final if args.quiet else record["summary"] + "\n" + _files_line(final))
+        print(
+            f"cache: answered from a solve of {record['cache']['solved']} (key {key}) in "
+            f"{(time.perf_counter() - start) * 1e3:.0f} ms; --no-cache solves again",
+            file=sys.stderr,
+        )
+        return 0
+
+    from .pipeline import run_and_record
+
+    folder, solved, record = run_and_record(
+        params, settings, root, args.case, command=sys.argv[:], plots=not args.no_plots
+    )
+    _warn_morse(record)
+    text = _summary(solved, folder, record)
+    record.update(summary=text, cache={"hit": False, "key": key})
+    write_json(folder / "run.json", record)
+    cache.store(key, folder)
+    print(folder if args.quiet else text + "\n" + _files_line(folder))
     return 0
 
 

@@ -7,8 +7,6 @@ import tomllib
 from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
 
-import numpy as np
-
 PARAM_NAMES = ("L3", "k1", "k2", "p2x", "p3x", "p3y", "p6x", "p5x", "p5y", "L01", "L02")
 
 PARAM_UNITS = {
@@ -169,8 +167,10 @@ def make_params(
     return Params(**values)
 
 
-def spring_vectors_cs(params: Params, c1, s1, c2, s2) -> dict[str, np.ndarray]:
+def spring_vectors_cs(params: Params, c1, s1, c2, s2) -> dict:
     """Spring vectors 2 -> 6, 3 -> 5 and the rod 1 -> 4 in frame B from c_i, s_i (any dtype)."""
+    import numpy as np  # here, so that loading parameters stays light (cache hits need no numpy)
+
     p = params
     p4 = np.stack([p.L3 * c1, p.L3 * s1], axis=-1)
     p6 = p4 + np.stack([c2 * p.p6x, s2 * p.p6x], axis=-1)

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import datetime as dt
-import secrets
 import tempfile
 import time
 from contextlib import contextmanager
@@ -18,7 +17,7 @@ from .geometry import Params
 from .parse import BertiniOutput, read_output
 from .polynomial import PolySystem
 from .render import render_input
-from .results import write_csv, write_json
+from .results import link_latest, new_run_folder, write_csv, write_json
 from .settings import Settings
 from .solver import run_bertini
 from .stability import Tolerances, classify, morse_check
@@ -167,14 +166,6 @@ def summary_counts(solved: Solved) -> dict[str, int]:
     }
 
 
-def new_run_folder(root: Path) -> tuple[Path, Path]:
-    """A (working, final) pair of folder names under root; work happens in a hidden folder."""
-    stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
-    name = f"{stamp}-{secrets.token_hex(3)}"
-    root.mkdir(parents=True, exist_ok=True)
-    return root / f".partial-{name}", root / name
-
-
 def run_and_record(
     params: Params,
     settings: Settings,
@@ -248,9 +239,5 @@ def run_and_record(
     )
     write_json(work / "run.json", record)
     work.rename(final)
-    latest = root / "latest"
-    if latest.is_symlink() or not latest.exists():
-        tmp_link = root / f".latest-{final.name}"
-        tmp_link.symlink_to(final.name)
-        tmp_link.replace(latest)
+    link_latest(root, final)
     return final, solved, record

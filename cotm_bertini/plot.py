@@ -463,14 +463,16 @@ def bifurcation_figure(
     The paper's Figs. 5 and 6 in one figure with a shared parameter axis. Physical equilibria
     only unless `show_all`, which adds the other real roots (negative d, d = 0 artefacts) in
     light grey. Every plotted row is a marker: stable ones filled circles, unstable ones small
-    hollow circles. With a `branch` column, the samples of a branch are joined by lines in the
-    branch's colour, thick and solid where stable, thin and dashed where unstable; never across
-    0/360 deg or a gap (see _branch_links). `events` (kind, value, gamma1_deg, gamma2_deg) are
-    marked in both panels.
+    hollow circles, non-physical ones grey dots. With a `branch` column, the samples of a branch
+    are joined by lines in the branch's colour (grey if not physical), thick and solid where
+    stable, thin and dashed where unstable; never across 0/360 deg or a gap (see _branch_links).
+    With branches and more than 60 parameter values the lines carry the picture: only the stable
+    markers are drawn (small, on the thick lines). `events` (columns kind, value, gamma1_deg,
+    gamma2_deg) are marked in both panels.
 
     Each panel's Axes has gid `gamma1` or `gamma2`. Its marker collections have gids `stable`,
-    `unstable`, `nonphysical` and one per event kind, offsets (param value, angle in deg); its
-    line collections have gids `stable-lines`, `unstable-lines`, `nonphysical-lines`.
+    `unstable`, `nonphysical` (when drawn) and one per event kind, offsets (param value, angle in
+    deg); its line collections have gids `stable-lines`, `unstable-lines`, `nonphysical-lines`.
     """
     real = _flag(sweep, "is_real")
     physical = _flag(sweep, "physical")
@@ -529,7 +531,7 @@ def bifurcation_figure(
                 )
                 ax.add_collection(coll)
         for style_name in ("nonphysical", "unstable", "stable"):
-            if dense and style_name != "stable":
+            if style_name == "nonphysical" or (dense and style_name != "stable"):
                 continue  # the lines say it; beads of markers would hide the dashes
             sel = rows[rows["_style"] == style_name]
             x, y = sel[param].to_numpy(dtype=float), sel[angle].to_numpy(dtype=float) % 360.0

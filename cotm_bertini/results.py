@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
+import datetime as dt
 import json
 import os
+import secrets
 import tempfile
 from pathlib import Path
-
-import pandas as pd
 
 
 def atomic_write_text(path: Path, text: str) -> None:
@@ -30,7 +30,7 @@ def write_text(path: Path, text: str) -> None:
     atomic_write_text(path, text)
 
 
-def write_csv(path: Path, frame: pd.DataFrame) -> None:
+def write_csv(path: Path, frame) -> None:
     """A CSV that loads straight into pandas or a spreadsheet, written atomically."""
     atomic_write_text(path, frame.to_csv(index=False))
 
@@ -38,3 +38,20 @@ def write_csv(path: Path, frame: pd.DataFrame) -> None:
 def write_json(path: Path, data: dict) -> None:
     """Pretty JSON, written atomically."""
     atomic_write_text(path, json.dumps(data, indent=2, sort_keys=False, default=str) + "\n")
+
+
+def new_run_folder(root: Path) -> tuple[Path, Path]:
+    """A (working, final) pair of folder names under root; work happens in a hidden folder."""
+    stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
+    name = f"{stamp}-{secrets.token_hex(3)}"
+    root.mkdir(parents=True, exist_ok=True)
+    return root / f".partial-{name}", root / name
+
+
+def link_latest(root: Path, final: Path) -> None:
+    """root/latest -> the newest run folder (replaced atomically)."""
+    latest = root / "latest"
+    if latest.is_symlink() or not latest.exists():
+        tmp_link = root / f".latest-{final.name}"
+        tmp_link.symlink_to(final.name)
+        tmp_link.replace(latest)

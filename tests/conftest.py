@@ -13,6 +13,15 @@ FIXTURES = ROOT.parent / "shared" / "fixtures" / "bertini-1.6"
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 
+def pytest_configure(config):
+    """One fresh cache for the whole session (generic solution sets and solves): tests never
+    read a cache left by an earlier run or by a user, and child processes inherit it."""
+    import os
+    import tempfile
+
+    os.environ["COTM_CACHE"] = tempfile.mkdtemp(prefix="cotm-test-cache-")
+
+
 @cache
 def solved(case: str, k2: float | None = None):
     """Solve a case once per session (optionally with another k2) and keep the Solved record."""

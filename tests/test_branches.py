@@ -116,8 +116,9 @@ def test_fold_confirmed_by_direct_solves(fold, solves):
     below, above = solves[-1e-4], solves[1e-4]
     assert len(below) == len(above) == 22
     assert abs(int(above["is_real"].sum()) - int(below["is_real"].sum())) == 2
-    real_side, complex_side = (above, below) if "real above" in fold["description"] else (
-        below, above)
+    real_side, complex_side = (
+        (above, below) if "real above" in fold["description"] else (below, above)
+    )
     near_real, near_complex = _near(real_side, g1, g2), _near(complex_side, g1, g2)
     assert int(real_side["is_real"].sum()) == int(complex_side["is_real"].sum()) + 2
     assert len(near_real) == 2 and near_real["is_real"].all()
@@ -144,8 +145,9 @@ def test_fold_satisfies_augmented_system(fold):
         assert len(roots), d
         imag = np.abs(roots.imag).max()
         spread = np.ptp(roots.real, axis=0).max()
-        kinds.append("real" if imag < 1e-12 and spread > 1e-6 else
-                     "complex" if imag > 1e-6 else "unclear")
+        kinds.append(
+            "real" if imag < 1e-12 and spread > 1e-6 else "complex" if imag > 1e-6 else "unclear"
+        )
     assert sorted(kinds) == ["complex", "real"], kinds
     assert ("real above" in fold["description"]) == (kinds[1] == "real")
 

@@ -195,3 +195,22 @@ def test_verify_case1_all_routes_agree():
         line = next(ln for ln in r.stdout.splitlines() if route in ln)
         assert " agrees " in line, line
     assert "all routes agree" in r.stdout
+
+
+def test_second_identical_request_is_answered_from_the_cache(tmp_path):
+    """Same request twice: the second run says it used the cache and has the same table;
+    --no-cache solves again; a changed parameter is a different request."""
+    args = ["solve", "case2", "--out", str(tmp_path), "--no-plots", "--quiet"]
+    first = cli(*args)
+    second = cli(*args)
+    assert first.returncode == 0 and second.returncode == 0, second.stderr
+    assert "cache: answered" not in first.stderr and "cache: answered" in second.stderr
+    a, b = Path(first.stdout.strip()), Path(second.stdout.strip())
+    assert a != b
+    assert (a / "solutions.csv").read_text() == (b / "solutions.csv").read_text()
+    rec = json.loads((b / "run.json").read_text())
+    assert rec["cache"]["hit"] is True
+    third = cli(*args, "--no-cache")
+    assert "cache: answered" not in third.stderr
+    changed = cli(*args, "--set", "L01=11.4")
+    assert "cache: answered" not in changed.stderr

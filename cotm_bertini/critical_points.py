@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .equations import energy, energy_gradient, energy_hessian
+from .compiled import energy, energy_gradient, energy_hessian
 from .geometry import Params
 
 

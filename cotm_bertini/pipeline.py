@@ -12,7 +12,7 @@ from pathlib import Path
 import pandas as pd
 
 from . import engine as engine_mod
-from .equations import polynomial_system
+from .compiled import polynomial_system
 from .geometry import Params
 from .parse import BertiniOutput, read_output
 from .polynomial import PolySystem
@@ -89,7 +89,7 @@ def solve_in(
 def _solve_homotopy(
     folder: Path, params: Params, settings: Settings, tolerances: Tolerances
 ) -> Solved:
-    from .equations import parametric_system
+    from .compiled import parametric_system
     from .homotopy import generic_set, solve_target
     from .render import render_parameter_homotopy
 

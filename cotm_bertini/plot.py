@@ -376,9 +376,9 @@ def plot_run(params: Params, solutions: pd.DataFrame, folder: str | Path) -> lis
 _SWEEP_LINE = {"stable": (2.6, "-"), "unstable": (1.1, (0, (5, 2.5))), "nonphysical": (0.7, "-")}
 _NONPHYSICAL_COLOUR = "0.72"
 EVENT_STYLE = {  # marker, colour, size, label
-    "fold": ("x", "black", 70, "fold (two branches meet and turn complex)"),
-    "stability_change": ("D", "black", 38, "stability change"),
-    "physical_change": ("v", "0.35", 38, "physical change (a spring length crosses 0)"),
+    "fold": ("x", "black", 50, "fold (two branches meet and turn complex)"),
+    "stability_change": ("D", "black", 95, "stability change"),
+    "physical_change": ("v", "0.35", 60, "physical change (a spring length crosses 0)"),
 }
 # Two consecutive samples of a branch further apart than this (short way round, deg) are not
 # joined: the branch is poorly resolved there, and a long line would only mislead.
@@ -473,6 +473,8 @@ def bifurcation_figure(
     Each panel's Axes has gid `gamma1` or `gamma2`. Its marker collections have gids `stable`,
     `unstable`, `nonphysical` (when drawn) and one per event kind, offsets (param value, angle in
     deg); its line collections have gids `stable-lines`, `unstable-lines`, `nonphysical-lines`.
+    Rows whose branch is missing or negative are markers only. The events' parameter column is
+    `value`, or else `param` itself.
     """
     real = _flag(sweep, "is_real")
     physical = _flag(sweep, "physical")
@@ -492,6 +494,7 @@ def bifurcation_figure(
     colour_of = {}
     if has_branches:
         phys_branches = rows.loc[rows["_style"] != "nonphysical", "branch"].dropna()
+        phys_branches = phys_branches[phys_branches >= 0]
         colour_of = _branch_colours(sorted(phys_branches.unique()))
 
     fig = Figure(figsize=(10.5, 9.0), layout="constrained")
@@ -503,7 +506,8 @@ def bifurcation_figure(
         if has_branches:
             pieces: dict[str, list] = {"stable": [], "unstable": [], "nonphysical": []}
             colours: dict[str, list] = {"stable": [], "unstable": [], "nonphysical": []}
-            for branch, grp in rows.dropna(subset=["branch"]).groupby("branch", sort=True):
+            joined = rows.dropna(subset=["branch"])
+            for branch, grp in joined[joined["branch"] >= 0].groupby("branch", sort=True):
                 grp = grp.sort_values(param, kind="stable")
                 x = grp[param].to_numpy(dtype=float)
                 for style_name, pts in _branch_links(
@@ -531,7 +535,7 @@ def bifurcation_figure(
                 )
                 ax.add_collection(coll)
         for style_name in ("nonphysical", "unstable", "stable"):
-            if style_name == "nonphysical" or (dense and style_name != "stable"):
+            if dense and style_name != "stable":
                 continue  # the lines say it; beads of markers would hide the dashes
             sel = rows[rows["_style"] == style_name]
             x, y = sel[param].to_numpy(dtype=float), sel[angle].to_numpy(dtype=float) % 360.0
@@ -554,9 +558,10 @@ def bifurcation_figure(
                 ev = events[events["kind"] == kind]
                 if len(ev) == 0:
                     continue
+                at = "value" if "value" in ev else param
                 filled = marker not in ("x", "+")
                 ax.scatter(
-                    ev["value"].to_numpy(dtype=float),
+                    ev[at].to_numpy(dtype=float),
                     ev[angle].to_numpy(dtype=float) % 360.0,
                     s=size,
                     marker=marker,

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from .equations import tan_half_jacobian
+from .compiled import tan_half_jacobian
 from .geometry import Params
 from .paper import TABLES, PaperTable
 from .stability import zero_length_configurations
@@ -29,7 +29,7 @@ def _elimination_artefact(params: Params, g1: float, g2: float, rtol: float = 2e
     """
     if params.zfl != (False, True):
         return False
-    from .equations import polynomial_system
+    from .compiled import polynomial_system
 
     system = polynomial_system(params)
     c1, s1, c2, s2 = np.cos(g1), np.sin(g1), np.cos(g2), np.sin(g2)

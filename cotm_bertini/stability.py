@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from .equations import energy, energy_hessian, tan_half_jacobian
+from .compiled import energy, energy_hessian, tan_half_jacobian
 from .geometry import Params, spring_vectors_cs
 from .polynomial import PolySystem
 

@@ -94,7 +94,7 @@ def solve_point(
     base: dict[str, float], values: dict[str, float], seed: int, threads: int | None = 1
 ) -> pd.DataFrame:
     """All finite solutions at one point, classified, with how they were obtained."""
-    from .equations import parametric_system
+    from .compiled import parametric_system
     from .homotopy import solve_target
     from .stability import classify
 
@@ -156,7 +156,7 @@ def load_spec(folder: Path) -> SweepSpec:
 
 def warm_generic_sets(spec: SweepSpec) -> None:
     """Solve (or load) the generic sets every point needs, once, before workers start."""
-    from .equations import parametric_system
+    from .compiled import parametric_system
     from .homotopy import generic_set
 
     structures = {Params(**{**spec.base, **v}).zfl for v in spec.grid()}

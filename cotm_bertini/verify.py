@@ -7,8 +7,8 @@ from dataclasses import dataclass
 
 import pandas as pd
 
+from .compiled import polynomial_system
 from .critical_points import compare_physical, critical_points
-from .equations import polynomial_system
 from .geometry import Params
 from .resultant import case1_resultant, case2_resultant
 from .resultant import compare as compare_sets

@@ -268,6 +268,10 @@ def test_events_are_marked_with_a_legend(sweep1d):
     assert EVENT_STYLE["fold"][3] in labels and EVENT_STYLE["stability_change"][3] in labels
     assert EVENT_STYLE["physical_change"][3] not in labels
     assert any("stable" in t for t in labels) and any("unstable" in t for t in labels)
+    # branches.find_events names the value column after the parameter: same markers.
+    renamed = bifurcation_figure(sweep1d, "L01", events=events.rename(columns={"value": "L01"}))
+    for name, ax in _panels(renamed).items():
+        np.testing.assert_allclose(_offsets(ax, "fold"), _offsets(_panels(fig)[name], "fold"))
 
 
 def test_count_map_equals_the_per_point_counts(sweep2d, tmp_path):

@@ -17,7 +17,10 @@ class Tolerances:
     """Thresholds of the classification; each is documented in the README."""
 
     imag: float = 1e-8  # |Im| of every variable below this (relative to 1 + |x|): real
-    singular_condition: float = 1e8  # condition number above this: a singular endpoint
+    # Condition number of the Jacobian at the refined point above this: a singular endpoint.
+    # Ordinary roots with large |d| reach 1e9 (the variables are not scaled); exactly singular
+    # ones (d = 0 artefacts) 1e14 and up.
+    singular_condition: float = 1e12
     zero_length: float = 1e-5  # |d| below this times L3 at a singular endpoint: d = 0 artefact
     merge: float = 1e-8  # nonsingular endpoints closer than this (relative) are one solution
     hessian: float = 1e-9  # eigenvalues within this (relative to k L3^2) of 0: degenerate
@@ -90,9 +93,14 @@ def classify(
     x0 = endpoints[list(variables)].to_numpy(dtype=complex)
     cond = endpoints["condition_number"].to_numpy(dtype=float)
     acc = endpoints["accuracy_estimate"].fillna(0.0).to_numpy(dtype=float)
-    singular = (cond > tol.singular_condition) | (endpoints["bertini_multiplicity"] > 1).to_numpy()
     x, res = newton_refine(system, x0, 0 if len(x0) == 0 else tol.newton_steps)
-    x[singular] = x0[singular]  # Newton does not converge quadratically there; keep Bertini's
+    # Our own condition number at the refined point: Bertini's estimate is taken wherever its
+    # endgame stopped and varies by orders of magnitude between runs near a singular root.
+    jac_cond = np.linalg.cond(system.jacobian(x)) if len(x) else np.zeros(0)
+    jac_cond = np.where(np.isfinite(jac_cond), jac_cond, np.inf)
+    singular = (jac_cond > tol.singular_condition) | (
+        endpoints["bertini_multiplicity"] > 1
+    ).to_numpy()
     labels = cluster_endpoints(x, singular, acc, tol.merge)
 
     rows = []
@@ -107,6 +115,7 @@ def classify(
                     str(int(p)) for p in endpoints["path_number"].to_numpy()[members]
                 ),
                 "condition_number": float(cond[members].max()),
+            "jacobian_condition": float(jac_cond[members].min()),
                 "singular": bool(singular[members].any() or len(members) > 1),
                 "accuracy": float(acc[members].max()),
             }
@@ -157,6 +166,7 @@ def classify(
     frame["physical"] = physical
     frame["residual"] = absres
     frame["condition_number"] = [r["condition_number"] for r in rows]
+    frame["jacobian_condition"] = [r["jacobian_condition"] for r in rows]
     frame["multiplicity"] = [r["multiplicity"] for r in rows]
     frame["singular"] = sing
 
@@ -238,6 +248,7 @@ COLUMNS = [
     "multiplicity",
     "reason",
     "singular",
+    "jacobian_condition",
     "kind",
     "energy",
     "hess_eig1",
@@ -246,6 +257,7 @@ COLUMNS = [
     "spring2_force",
     "rod_force",
     "tensegrity",
+    "paper_stable",
     "gamma1_imag_deg",
     "gamma2_imag_deg",
     "paths",

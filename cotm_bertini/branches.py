@@ -120,21 +120,20 @@ def hungarian(cost: np.ndarray) -> np.ndarray:
 def assign_branches(sweep: pd.DataFrame, param: str) -> pd.DataFrame:
     """A copy of `sweep` with an integer `branch` column joining solutions across its points."""
     out = sweep.copy()
-    out["branch"] = -1
+    branch = np.full(len(sweep), -1, dtype=int)
     ls = _length_scale(sweep)
-    key = "point" if "point" in sweep.columns else param
+    keys = sweep["point" if "point" in sweep.columns else param].to_numpy()
+    sid = sweep["solution_id"].to_numpy() if "solution_id" in sweep.columns else None
     history: dict[int, list[tuple[float, np.ndarray]]] = {}
     active: list[int] = []  # branches present at the previous point
     next_id = 0
     for pkey, value in _point_order(sweep, param):
-        idx = sweep.index[(sweep[key] == pkey).to_numpy()]
-        rows = sweep.loc[idx]
-        if "solution_id" in rows.columns:
-            rows = rows.sort_values("solution_id", kind="stable")
-            idx = rows.index
-        x = match_coordinates(rows, ls)
+        pos = np.flatnonzero(keys == pkey)
+        if sid is not None:
+            pos = pos[np.argsort(sid[pos], kind="stable")]
+        x = match_coordinates(sweep.iloc[pos], ls)
         good = np.isfinite(x[:, : len(ANGLE_VARS)]).all(axis=1)
-        x, idx = x[good], idx[good]
+        x, pos = x[good], pos[good]
         pred = np.array([_predict(history[b], value) for b in active]).reshape(-1, x.shape[1])
         cols = np.isfinite(x).all(axis=0) & np.isfinite(pred).all(axis=0)
         diff = np.abs(pred[:, None, cols] - x[None, :, cols])
@@ -143,17 +142,14 @@ def assign_branches(sweep: pd.DataFrame, param: str) -> pd.DataFrame:
         for a, j in enumerate(match):
             if j >= 0:
                 owner[j] = active[a]
-        new_active = []
-        for j in range(len(x)):
-            b = int(owner[j])
-            if b < 0:
-                b, next_id = next_id, next_id + 1
-                history[b] = []
-            history[b].append((value, x[j]))
-            new_active.append(b)
-            out.loc[idx[j], "branch"] = b
-        active = new_active
-    out["branch"] = out["branch"].astype(int)
+        for j in np.flatnonzero(owner < 0):
+            owner[j], next_id = next_id, next_id + 1
+            history[int(owner[j])] = []
+        for j, b in enumerate(owner):
+            history[int(b)].append((value, x[j]))
+        branch[pos] = owner
+        active = [int(b) for b in owner]
+    out["branch"] = branch
     return out
 
 
@@ -191,11 +187,14 @@ def _structure(base: Mapping[str, float], param: str, value: float) -> _Structur
     return _Structure(parametric_system(params.zfl), params.as_dict(), param)
 
 
-def _newton(system: PolySystem, x: np.ndarray, steps: int = 30) -> tuple[np.ndarray, bool]:
-    """Real Newton on F(x) = 0 from x; (x, converged)."""
+def _newton(system: PolySystem, x: np.ndarray, steps: int = 12) -> tuple[np.ndarray, bool]:
+    """Real Newton on F(x) = 0 from x; (x, converged: relative residual below 1e-11)."""
     x = np.asarray(x, dtype=float).copy()
+    scale = system.scale()
     for _ in range(steps):
         f = system.evaluate(x)[0].real
+        if np.abs(f / scale).max() < 1e-14:
+            break
         jac = system.jacobian(x)[0].real
         try:
             dx = np.linalg.solve(jac, f)
@@ -204,36 +203,40 @@ def _newton(system: PolySystem, x: np.ndarray, steps: int = 30) -> tuple[np.ndar
         if not np.isfinite(dx).all():
             return x, False
         x -= dx
-        if np.abs(dx).max() <= 1e-13 * (1.0 + np.abs(x).max()):
-            return x, True
-    return x, False
+    return x, bool(np.abs(system.evaluate(x)[0] / scale).max() < 1e-11)
 
 
 def _fold_newton(
-    st: _Structure, x: np.ndarray, v: np.ndarray, p: float, steps: int = 40
+    st: _Structure, x: np.ndarray, v: np.ndarray, p: float, steps: int = 60
 ) -> tuple[np.ndarray, np.ndarray, float, float, bool]:
-    """Newton in (x, v, p) on F = 0, J v = 0, r.v = 1 (r: the initial null vector)."""
+    """Newton in (x, v, p) on F = 0, J v = 0, r.v = 1 (r: the initial null vector).
+
+    Returns (x, v, p, accuracy in p, converged). At a regular fold Newton converges
+    quadratically and the accuracy is the last |dp|; where the augmented system is itself
+    singular (a pitchfork) it stalls at a noise floor, and the accuracy is the spread of p over
+    the last iterations.
+    """
     n = len(x)
     r = v / (v @ v)
     x, v = x.astype(float).copy(), v.astype(float).copy()
-    last = np.inf
+    ps: list[float] = []
     for _ in range(steps):
         sys0 = st.system(p)
         sysh = st.system(p + 1j * _CSTEP)
         f = sys0.evaluate(x)[0].real
         jac = sys0.jacobian(x)[0].real
-        jv = jac @ v
         # d(J v)/dx by complex steps in x; dF/dp and d(J v)/dp by a complex step in p.
         xs = x[None, :] + 1j * _CSTEP * np.eye(n)
         hess_v = (sys0.jacobian(xs) @ v).imag.T / _CSTEP
         jac_h = sysh.jacobian(x)[0]
-        f_p = sysh.evaluate(x)[0].imag / _CSTEP
-        jv_p = (jac_h @ v).imag / _CSTEP
         big = np.zeros((2 * n + 1, 2 * n + 1))
-        big[:n, :n], big[:n, 2 * n] = jac, f_p
-        big[n : 2 * n, :n], big[n : 2 * n, n : 2 * n], big[n : 2 * n, 2 * n] = hess_v, jac, jv_p
+        big[:n, :n] = jac
+        big[:n, 2 * n] = sysh.evaluate(x)[0].imag / _CSTEP
+        big[n : 2 * n, :n] = hess_v
+        big[n : 2 * n, n : 2 * n] = jac
+        big[n : 2 * n, 2 * n] = (jac_h @ v).imag / _CSTEP
         big[2 * n, n : 2 * n] = r
-        rhs = np.concatenate([f, jv, [r @ v - 1.0]])
+        rhs = np.concatenate([f, jac @ v, [r @ v - 1.0]])
         try:
             step = np.linalg.solve(big, rhs)
         except np.linalg.LinAlgError:
@@ -241,10 +244,11 @@ def _fold_newton(
         if not np.isfinite(step).all():
             return x, v, p, np.inf, False
         x, v, p = x - step[:n], v - step[n : 2 * n], p - step[2 * n]
-        last = abs(step[2 * n])
-        if last < FOLD_TOL and np.abs(step).max() < 1e-9 * (1 + np.abs(x).max()):
-            return x, v, p, last, True
-    return x, v, p, last, False
+        ps.append(p)
+        if abs(step[2 * n]) < FOLD_TOL and np.abs(step).max() < 1e-9 * (1 + np.abs(x).max()):
+            return x, v, p, abs(step[2 * n]), True
+    spread = float(np.ptp(ps[-10:]))
+    return x, v, p, spread, spread < 1e-8
 
 
 def _angles(variables: tuple[str, ...], x: np.ndarray) -> tuple[float, float]:
@@ -266,6 +270,22 @@ def _row_x(row: pd.Series, variables: tuple[str, ...]) -> np.ndarray:
 
 # --- events ----------------------------------------------------------------------------------
 
+EVENT_COLUMNS = [
+    "kind",
+    "branches",
+    "gamma1_deg",
+    "gamma2_deg",
+    "refined",
+    "residual",
+    "bracket",
+    "description",
+    "lo",
+    "hi",
+    "variables",
+    "x",
+    "null_vector",
+]
+
 
 def find_events(
     sweep_with_branches: pd.DataFrame,
@@ -273,7 +293,15 @@ def find_events(
     base_params: Mapping[str, float] | Params,
     seed: int = 1,
 ) -> pd.DataFrame:
-    """Folds, stability changes and physical changes between neighbouring points, refined."""
+    """Folds (and pitchforks), stability and physical changes between neighbouring points.
+
+    Columns: kind, branches, the parameter (refined value), gamma1_deg, gamma2_deg at the event,
+    refined, residual (fold: max |F|, |J v| relative to the coefficients; stability change:
+    |eigenvalue| / max |eigenvalue| of the energy Hessian there; physical change: the larger of
+    |d_i| and the relative |F| there), bracket (the accuracy of the value:
+    last Newton step or bracket width), description, lo and hi (the sweep points around it), and
+    the point itself: variables, x and (folds) the null vector v of J_x.
+    """
     sw = sweep_with_branches
     base = base_params.as_dict() if isinstance(base_params, Params) else dict(base_params)
     order = _point_order(sw, param)
@@ -282,38 +310,27 @@ def find_events(
     events: list[dict] = []
     for (ka, pa), (kb, pb) in zip(order[:-1], order[1:], strict=True):
         A, B = by_point[ka], by_point[kb]
-        sa, sb = _structure(base, param, pa), _structure(base, param, pb)
-        if sa.ps.variables != sb.ps.variables:
+        st = _structure(base, param, pa)
+        if st.ps.variables != _structure(base, param, pb).ps.variables:
             continue  # a change of structure (a free length reaching 0) is not an event
+        ctx = _Ctx(base, param, seed, st, pa, pb, A, B)
         common = [b for b in A.index if b in B.index and b >= 0]
         ra = {b: bool(A.loc[b, "is_real"]) for b in common}
         rb = {b: bool(B.loc[b, "is_real"]) for b in common}
-        ctx = _Ctx(base, param, seed, sa, pa, pb, A, B)
-        to_complex = [b for b in common if ra[b] and not rb[b]]
-        to_real = [b for b in common if not ra[b] and rb[b]]
-        for real_side, group in (("left", to_complex), ("right", to_real)):
-            for pair in _conjugate_pairs(group, B if real_side == "left" else A, sa.ps.variables):
-                events.extend(_fold_events(ctx, pair, real_side))
+        here: list[dict] = []
         for b in common:
             if ra[b] and rb[b]:
-                events.extend(_along_branch_events(ctx, b))
-    cols = [
-        "kind",
-        "branches",
-        param,
-        "gamma1_deg",
-        "gamma2_deg",
-        "refined",
-        "residual",
-        "bracket",
-        "description",
-        "lo",
-        "hi",
-        "variables",
-        "x",
-        "null_vector",
-    ]
-    frame = pd.DataFrame(events, columns=cols)
+                here.extend(_along_branch_events(ctx, b))
+        for real_side, group in (
+            ("left", [b for b in common if ra[b] and not rb[b]]),
+            ("right", [b for b in common if rb[b] and not ra[b]]),
+        ):
+            complex_side = B if real_side == "left" else A
+            for pair in _conjugate_pairs(group, complex_side, st.ps.variables):
+                third = [b for b in common if ra[b] and rb[b]]
+                here.extend(_fold_events(ctx, pair, real_side, third, here))
+        events.extend(here)
+    frame = pd.DataFrame(events, columns=EVENT_COLUMNS[:2] + [param] + EVENT_COLUMNS[2:])
     return frame.sort_values([param, "kind", "branches"], kind="stable").reset_index(drop=True)
 
 
@@ -328,20 +345,40 @@ class _Ctx:
     A: pd.DataFrame
     B: pd.DataFrame
 
+    def event(self, kind: str, branches: str, value: float, x: np.ndarray, **info) -> dict:
+        g1, g2 = _angles(self.st.ps.variables, x)
+        return {
+            "kind": kind,
+            "branches": branches,
+            self.param: float(value),
+            "gamma1_deg": g1,
+            "gamma2_deg": g2,
+            "lo": min(self.pa, self.pb),
+            "hi": max(self.pa, self.pb),
+            "variables": tuple(self.st.ps.variables),
+            "x": tuple(float(c) for c in x),
+            "null_vector": None,
+            **info,
+        }
+
 
 def _conjugate_pairs(group: list[int], side: pd.DataFrame, variables) -> list[tuple[int, int]]:
     """Pair the branches of `group` whose points on the complex `side` are conjugates."""
     left = sorted(group)
     pairs = []
     while len(left) >= 2:
-        best = None
-        for i, a in enumerate(left):
-            for b in left[i + 1 :]:
-                xa, xb = _row_x(side.loc[a], variables), _row_x(side.loc[b], variables)
-                gap = np.abs(xa - np.conj(xb)).max()
-                if best is None or gap < best[0]:
-                    best = (gap, a, b)
-        _, a, b = best
+        gaps = [
+            (
+                np.abs(
+                    _row_x(side.loc[a], variables) - np.conj(_row_x(side.loc[b], variables))
+                ).max(),
+                a,
+                b,
+            )
+            for i, a in enumerate(left)
+            for b in left[i + 1 :]
+        ]
+        _, a, b = min(gaps)
         pairs.append((a, b))
         left = [c for c in left if c not in (a, b)]
     return pairs
@@ -349,12 +386,15 @@ def _conjugate_pairs(group: list[int], side: pd.DataFrame, variables) -> list[tu
 
 def _label(row: pd.Series) -> str:
     if bool(row["physical"]):
-        return f"{row['kind'] or 'physical'}"
-    return str(row["reason"]) or "real"
+        return str(row["kind"]) or "physical"
+    return str(row["reason"]) if isinstance(row["reason"], str) and row["reason"] else "real"
 
 
-def _fold_events(ctx: _Ctx, pair: tuple[int, int], real_side: str) -> list[dict]:
-    """The fold where branches `pair` meet, refined; plus a stability change if one is lost."""
+def _fold_events(
+    ctx: _Ctx, pair: tuple[int, int], real_side: str, third: list[int], along: list[dict]
+) -> list[dict]:
+    """The fold where branches `pair` meet, refined; a pitchfork if a third branch passes
+    there; plus a stability change if the pair is a physical minimum and a saddle or maximum."""
     a, b = pair
     variables = ctx.st.ps.variables
     R, C = (ctx.A, ctx.B) if real_side == "left" else (ctx.B, ctx.A)
@@ -368,57 +408,93 @@ def _fold_events(ctx: _Ctx, pair: tuple[int, int], real_side: str) -> list[dict]
     x0 = (1 - t) * 0.5 * (xa_r + xb_r) + t * 0.5 * (xa_c + xb_c).real
     v0 = xa_r - xb_r
     v0 = v0 / np.linalg.norm(v0) if np.linalg.norm(v0) > 0 else np.eye(len(x0))[0]
-    x, v, p, last, ok = _fold_newton(ctx.st, x0, v0, p0)
+    x, v, p, acc, ok = _fold_newton(ctx.st, x0, v0, p0)
     lo, hi = min(ctx.pa, ctx.pb), max(ctx.pa, ctx.pb)
     margin = 1e-9 * max(1.0, abs(hi))
-    system = ctx.st.system(p) if np.isfinite(p) else None
-    if system is not None and np.isfinite(x).all():
-        resid = float(np.abs(system.evaluate(x)[0] / system.scale()).max())
-        resid = max(resid, float(np.abs(system.jacobian(x)[0] @ v).max() / system.scale().max()))
-    else:
-        resid = np.inf
+    resid = np.inf
+    if np.isfinite(p) and np.isfinite(x).all() and np.isfinite(v).all():
+        system = ctx.st.system(p)
+        scale = system.scale()
+        resid = float(
+            max(
+                np.abs(system.evaluate(x)[0] / scale).max(),
+                np.abs(system.jacobian(x)[0] @ v).max() / scale.max(),
+            )
+        )
     ok = bool(ok and lo - margin <= p <= hi + margin and resid < 1e-9)
     if not ok:
         x, v, p = x0, v0, p0
-    g1, g2 = _angles(variables, x)
     la, lb = _label(R.loc[a]), _label(R.loc[b])
-    side = "above" if pr > pc else "below"
+    side, other = ("above", "below") if pr > pc else ("below", "above")
+    kind, on = "fold", ""
+    # A third real branch through the meeting point makes it a pitchfork (e.g. where a branch
+    # passes through a configuration with both springs at their free lengths).
+    for c in third:
+        xc = _interpolate(ctx, c, p)
+        near = max(
+            1e-3,
+            0.1
+            * np.abs(
+                _row_x(ctx.B.loc[c], variables).real - _row_x(ctx.A.loc[c], variables).real
+            ).max(),
+        )
+        if np.abs(xc - x).max() < near:
+            kind = "pitchfork"
+            on = f" on branch {c} ({_label(ctx.A.loc[c])} below, {_label(ctx.B.loc[c])} above)"
+            for e in along:
+                if e["kind"] == "stability_change" and e["branches"] == str(c) and ok:
+                    e.update(
+                        {
+                            ctx.param: float(p),
+                            "refined": True,
+                            "bracket": acc,
+                            "description": e["description"] + f", at the pitchfork {a}+{b}",
+                        }
+                    )
+            break
     desc = (
-        f"branches {a} ({la}) and {b} ({lb}) meet: real {side} {ctx.param} = {p:.10g}, "
-        f"a complex-conjugate pair on the other side"
+        f"branches {a} ({la}) and {b} ({lb}) meet{on}: real {side} {ctx.param} = {p:.10g}, "
+        f"a complex-conjugate pair {other}"
     )
-    event = {
-        "kind": "fold",
-        "branches": f"{a}+{b}",
-        ctx.param: p,
-        "gamma1_deg": g1,
-        "gamma2_deg": g2,
-        "refined": ok,
-        "residual": resid,
-        "bracket": last,
-        "description": desc,
-        "lo": lo,
-        "hi": hi,
-        "variables": tuple(variables),
-        "x": tuple(float(c) for c in x),
-        "null_vector": tuple(float(c) for c in v),
-    }
+    event = ctx.event(
+        kind,
+        f"{a}+{b}",
+        p,
+        x,
+        refined=ok,
+        residual=resid,
+        bracket=acc,
+        description=desc,
+        null_vector=tuple(float(c) for c in v),
+    )
     out = [event]
     ra, rb = R.loc[a], R.loc[b]
-    if bool(ra["physical"]) and bool(rb["physical"]) and bool(ra["stable"]) != bool(rb["stable"]):
+    if (
+        kind == "fold"
+        and bool(ra["physical"])
+        and bool(rb["physical"])
+        and (bool(ra["stable"]) != bool(rb["stable"]))
+    ):
         (s, ls), (u, lu) = ((a, la), (b, lb)) if bool(ra["stable"]) else ((b, lb), (a, la))
-        eig = _hessian_eigs(ctx.st, p, variables, x) if ok else np.array([np.nan, np.nan])
-        small = float(np.abs(eig).min() / np.abs(eig).max())
+        eig = _hessian_eigs(ctx.st, p, variables, x)
         out.append(
             {
                 **event,
                 "kind": "stability_change",
-                "residual": small,
+                "residual": float(np.abs(eig).min() / np.abs(eig).max()),
                 "description": f"at the fold: the stable {ls} {s} and the {lu} {u} merge "
-                "(an energy-Hessian eigenvalue is 0 there)",
+                "(an energy-Hessian eigenvalue is 0 there; residual: |eig| / max |eig|)",
             }
         )
     return out
+
+
+def _interpolate(ctx: _Ctx, b: int, value: float) -> np.ndarray:
+    """Branch b's real point at `value`, linear between the interval's ends."""
+    variables = ctx.st.ps.variables
+    xa, xb = _row_x(ctx.A.loc[b], variables).real, _row_x(ctx.B.loc[b], variables).real
+    t = (value - ctx.pa) / (ctx.pb - ctx.pa)
+    return (1 - t) * xa + t * xb
 
 
 def _along_branch_events(ctx: _Ctx, b: int) -> list[dict]:
@@ -426,97 +502,100 @@ def _along_branch_events(ctx: _Ctx, b: int) -> list[dict]:
     ra, rb = ctx.A.loc[b], ctx.B.loc[b]
     variables = ctx.st.ps.variables
     out = []
-    if bool(ra["physical"]) and bool(rb["physical"]) and not ra["singular"] and not rb["singular"]:
-        ea = np.array([ra["hess_eig1"], ra["hess_eig2"]], float)
-        eb = np.array([rb["hess_eig1"], rb["hess_eig2"]], float)
-        if np.isfinite(ea).all() and np.isfinite(eb).all() and (np.sign(ea) != np.sign(eb)).any():
-            j = int(np.flatnonzero(np.sign(ea) != np.sign(eb))[0])
+    ea = np.array([ra["hess_eig1"], ra["hess_eig2"]], float)
+    eb = np.array([rb["hess_eig1"], rb["hess_eig2"]], float)
+    if np.isfinite(ea).all() and np.isfinite(eb).all() and (np.sign(ea) != np.sign(eb)).any():
+        j = int(np.flatnonzero(np.sign(ea) != np.sign(eb))[0])
 
-            def eig(value: float, x: np.ndarray, j: int = j) -> float:
-                return float(_hessian_eigs(ctx.st, value, variables, x)[j])
+        def eig(value: float, x: np.ndarray) -> float:
+            return float(_hessian_eigs(ctx.st, value, variables, x)[j])
 
-            p, x, width, ok, val = _bisect(ctx, ra, rb, eig)
-            g1, g2 = _angles(variables, x)
-            out.append(
-                {
-                    "kind": "stability_change",
-                    "branches": str(b),
-                    ctx.param: p,
-                    "gamma1_deg": g1,
-                    "gamma2_deg": g2,
-                    "refined": ok,
-                    "residual": abs(val),
-                    "bracket": width,
-                    "description": f"branch {b}: {ra['kind']} -> {rb['kind']} (Hessian "
-                    f"eigenvalue {j + 1} changes sign)",
-                    "lo": min(ctx.pa, ctx.pb),
-                    "hi": max(ctx.pa, ctx.pb),
-                    "variables": tuple(variables),
-                    "x": tuple(float(c) for c in x),
-                    "null_vector": None,
-                }
+        p, x, width, ok, val = _bisect(ctx, b, eig)
+        size = np.abs(_hessian_eigs(ctx.st, p, variables, x)).max()
+        out.append(
+            ctx.event(
+                "stability_change",
+                str(b),
+                p,
+                x,
+                refined=ok,
+                residual=abs(val) / size,
+                bracket=width,
+                description=f"branch {b}: {ra['kind']} -> {rb['kind']} (energy-Hessian eigenvalue "
+                f"{j + 1} changes sign)",
             )
+        )
     for i in (1, 2):
         da, db = float(ra[f"d{i}"]), float(rb[f"d{i}"])
-        if not (np.isfinite(da) and np.isfinite(db)) or np.sign(da) == np.sign(db):
-            continue
-        if f"d{i}" not in variables:
+        if f"d{i}" not in variables or not (min(da, db) < 0 < max(da, db)):
             continue
         k = variables.index(f"d{i}")
 
         def dval(value: float, x: np.ndarray, k: int = k) -> float:
             return float(x[k])
 
-        p, x, width, ok, val = _bisect(ctx, ra, rb, dval)
-        g1, g2 = _angles(variables, x)
-        now = "becomes" if da < 0 else "stops being"
+        p, x, width, ok, val = _bisect(ctx, b, dval)
+        system = ctx.st.system(p)
+        resid = max(
+            abs(val) / (1 + np.abs(x).max()), np.abs(system.evaluate(x)[0] / system.scale()).max()
+        )
+        now = "becomes" if da < db else "stops being"
         out.append(
-            {
-                "kind": "physical_change",
-                "branches": str(b),
-                ctx.param: p,
-                "gamma1_deg": g1,
-                "gamma2_deg": g2,
-                "refined": ok,
-                "residual": abs(val),
-                "bracket": width,
-                "description": f"branch {b}: d{i} crosses 0, {now} physical",
-                "lo": min(ctx.pa, ctx.pb),
-                "hi": max(ctx.pa, ctx.pb),
-                "variables": tuple(variables),
-                "x": tuple(float(c) for c in x),
-                "null_vector": None,
-            }
+            ctx.event(
+                "physical_change",
+                str(b),
+                p,
+                x,
+                refined=ok,
+                residual=resid,
+                bracket=width,
+                description=f"branch {b}: d{i} crosses 0 ({now} physical as {ctx.param} grows; "
+                "the spring's ends coincide there)",
+            )
         )
     return out
 
 
-def _bisect(
-    ctx: _Ctx, ra: pd.Series, rb: pd.Series, fn
-) -> tuple[float, np.ndarray, float, bool, float]:
-    """Bisection on fn(value, x) along a branch; the branch point at each midpoint is the
-    Newton-corrected interpolation of the bracket's ends (a fresh solve if Newton fails)."""
+def _bisect(ctx: _Ctx, b: int, fn) -> tuple[float, np.ndarray, float, bool, float]:
+    """Bisection on the sign of fn(value, x) along branch b between the interval's ends.
+
+    The branch point at each midpoint is the Newton-corrected interpolation of the bracket's
+    ends; if Newton fails or jumps to another branch, a fresh parameter-homotopy solve there
+    (at most twice), else the bisection stops (not refined). Returns (value, x, bracket width,
+    refined, fn there).
+    """
     variables = ctx.st.ps.variables
     lo, hi = ctx.pa, ctx.pb
-    xlo, xhi = _row_x(ra, variables).real, _row_x(rb, variables).real
+    xlo, xhi = _row_x(ctx.A.loc[b], variables).real, _row_x(ctx.B.loc[b], variables).real
     flo = fn(lo, xlo)
-    ok = True
+    ok, resolves = True, 2
     while abs(hi - lo) > BISECT_TOL:
         mid = 0.5 * (lo + hi)
-        x, conv = _newton(ctx.st.system(mid), 0.5 * (xlo + xhi))
-        if not conv or np.abs(x - 0.5 * (xlo + xhi)).max() > 10 * np.abs(xhi - xlo).max() + 1e-6:
-            x, conv = _resolve(ctx, mid, 0.5 * (xlo + xhi))
-            if not conv:
-                ok = False
-                break
+        guess = 0.5 * (xlo + xhi)
+        reach = 10 * np.abs(xhi - xlo).max() + 1e-6
+        x, conv = _newton(ctx.st.system(mid), guess)
+        if not conv or np.abs(x - guess).max() > reach:
+            conv = False
+            if resolves:
+                resolves -= 1
+                x, conv = _resolve(ctx, mid, guess)
+                conv = conv and np.abs(x - guess).max() <= reach
+        if not conv:
+            ok = False
+            break
         fm = fn(mid, x)
         if np.sign(fm) == np.sign(flo):
             lo, xlo, flo = mid, x, fm
         else:
             hi, xhi = mid, x
-    mid = 0.5 * (lo + hi)
-    x, conv = _newton(ctx.st.system(mid), 0.5 * (xlo + xhi))
-    return mid, x, abs(hi - lo), bool(ok and conv), fn(mid, x)
+    # The value: the midpoint of the final bracket, or (when the bisection had to stop early,
+    # e.g. where the branch runs into a singular root) the secant estimate inside it.
+    fhi = fn(hi, xhi)
+    t = 0.5 if ok or not np.isfinite([flo, fhi]).all() or flo == fhi else flo / (flo - fhi)
+    t = min(max(t, 0.0), 1.0)
+    x = (1 - t) * xlo + t * xhi
+    value = lo + t * (hi - lo)
+    return value, x, abs(hi - lo), ok, fn(value, x)
 
 
 def _resolve(ctx: _Ctx, value: float, near: np.ndarray) -> tuple[np.ndarray, bool]:
@@ -528,6 +607,5 @@ def _resolve(ctx: _Ctx, value: float, near: np.ndarray) -> tuple[np.ndarray, boo
     if table.empty:
         return near, False
     variables = ctx.st.ps.variables
-    xs = np.array([[r[f"{v}_re"] for v in variables] for _, r in table.iterrows()])
-    j = int(np.argmin(np.abs(xs - near).max(axis=1)))
-    return xs[j], True
+    xs = table[[f"{v}_re" for v in variables]].to_numpy(float)
+    return xs[int(np.argmin(np.abs(xs - near).max(axis=1)))], True

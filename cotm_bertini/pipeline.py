@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import datetime as dt
+import sys
 import tempfile
 import time
 from contextlib import contextmanager
@@ -19,7 +20,7 @@ from .polynomial import PolySystem
 from .render import render_input
 from .results import link_latest, new_run_folder, write_csv, write_json
 from .settings import Settings
-from .solver import run_bertini
+from .solver import SolverError, run_bertini
 from .stability import Tolerances, classify, morse_check
 
 
@@ -74,8 +75,23 @@ def solve_in(
     with t.stage("render"):
         text = render_input(system, settings, params.as_dict(), title)
     eng = engine_mod.find_engine(settings.bertini)
+    attempts: list[dict] = []
     with t.stage("solve"):
-        run = run_bertini(text, folder, eng, settings.timeout, settings.threads)
+        try:
+            run = run_bertini(text, folder, eng, settings.timeout, settings.threads)
+        except SolverError as first:
+            # One retry, as Bertini's own advice goes: a new random seed and tighter tracking.
+            attempts.append(_set_aside(folder, 1, settings, first))
+            retry = settings.retry()
+            text = render_input(system, retry, params.as_dict(), title)
+            try:
+                run = run_bertini(text, folder, eng, retry.timeout, retry.threads)
+            except SolverError as second:
+                attempts.append(_set_aside(folder, 2, retry, second))
+                raise SolverError(
+                    f"{first} -- retried with seed {retry.seed} and tighter tolerances: {second}"
+                ) from None
+            attempts.append({"attempt": 2, "settings": retry.bertini_config(), "ok": True})
     with t.stage("parse"):
         out = read_output(folder)
     with t.stage("classify"):
@@ -83,7 +99,31 @@ def solve_in(
     tracked = run.paths_tracked
     if tracked is None and settings.variable_groups == "total_degree":
         tracked = system.total_degree
-    return Solved(table, system, out, text, eng, run.version, run.seconds, tracked, t.stages)
+    return Solved(
+        table,
+        system,
+        out,
+        text,
+        eng,
+        run.version,
+        run.seconds,
+        tracked,
+        t.stages,
+        {"attempts": attempts} if attempts else {},
+    )
+
+
+def _set_aside(folder: Path, n: int, settings: Settings, error: Exception) -> dict:
+    """Move a failed attempt's files into folder/failed-attempt-n (kept, reported)."""
+    from .solver import ATTEMPT_PREFIX
+
+    keep = folder / f"{ATTEMPT_PREFIX}{n}"
+    keep.mkdir(parents=True, exist_ok=True)
+    for p in list(folder.iterdir()):
+        if not p.name.startswith(ATTEMPT_PREFIX):
+            p.rename(keep / p.name)
+    print(f"cotm-bertini: attempt {n} failed ({error}); files in {keep}", file=sys.stderr)
+    return {"attempt": n, "settings": settings.bertini_config(), "ok": False, "error": str(error)}
 
 
 def _solve_homotopy(

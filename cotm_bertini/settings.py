@@ -64,6 +64,19 @@ class Settings:
         cfg.update(self.extra_config)
         return cfg
 
+    def retry(self) -> Settings:
+        """Settings for a second attempt: another seed, tighter path tracking."""
+        from dataclasses import replace
+
+        before = min(self.tracktol_before_eg or 1e-5, 1e-5)
+        during = min(self.tracktol_during_eg or 1e-6, 1e-6)
+        return replace(
+            self,
+            seed=(self.seed + 7919) % 2**31,
+            tracktol_before_eg=float(f"{before / 100:.3g}"),
+            tracktol_during_eg=float(f"{during / 100:.3g}"),
+        )
+
     def as_dict(self) -> dict:
         """All settings, for run.json."""
         return asdict(self)

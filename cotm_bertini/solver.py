@@ -13,6 +13,7 @@ from pathlib import Path
 from .engine import Engine, child_environment
 
 REQUIRED_OUTPUTS = ("main_data", "finite_solutions")
+ATTEMPT_PREFIX = "failed-attempt-"
 
 
 class SolverError(RuntimeError):
@@ -48,7 +49,8 @@ def run_bertini(
 ) -> SolverRun:
     """Write `input` into an empty `folder` and run Bertini there, stdin from /dev/null."""
     folder.mkdir(parents=True, exist_ok=True)
-    if any(folder.iterdir()):
+    # Earlier failed attempts are kept in subfolders; anything else would be stale output.
+    if any(not p.name.startswith(ATTEMPT_PREFIX) for p in folder.iterdir()):
         raise SolverError(f"run folder {folder} is not empty: refusing to mix with stale output")
     (folder / "input").write_text(input_text)
     start = time.perf_counter()

@@ -115,7 +115,7 @@ def classify(
                     str(int(p)) for p in endpoints["path_number"].to_numpy()[members]
                 ),
                 "condition_number": float(cond[members].max()),
-            "jacobian_condition": float(jac_cond[members].min()),
+                "jacobian_condition": float(jac_cond[members].min()),
                 "singular": bool(singular[members].any() or len(members) > 1),
                 "accuracy": float(acc[members].max()),
             }

@@ -164,7 +164,44 @@ def test_solver_faults_are_reported_and_recorded(tmp_path, body, needle):
     assert len(failed) == 1
     rec = json.loads((failed[0] / "run.json").read_text())
     assert rec["status"] == "failed" and needle in rec["error"]
+    assert "retried with seed" in rec["error"] and "retried with seed" in r.stderr
+    for n in (1, 2):  # both attempts kept, each with what Bertini said
+        assert (failed[0] / f"failed-attempt-{n}" / "bertini.stderr").is_file()
     assert not list((tmp_path / "o").glob(".partial-*"))
+
+
+def test_a_failed_attempt_is_retried_with_a_new_seed(tmp_path, fixtures_dir):
+    """First Bertini run crashes, the retry (new seed, tighter tolerances) succeeds: exit 0,
+    run.json lists both attempts, the retry's input has the new seed."""
+    src = fixtures_dir / "case1"
+    marker = tmp_path / "crashed-once"
+    exe = _fake_bertini(
+        tmp_path,
+        f'if [ ! -e {marker} ]; then touch {marker}; echo "Segmentation fault" >&2; exit 139; fi\n'
+        f'for f in {src}/*; do n=$(basename "$f"); [ "$n" = input ] || cp "$f" .; done\n'
+        f"chmod u+w *; cat {src}/stdout.txt",
+    )
+    r = cli(
+        "solve",
+        "case1",
+        "--bertini",
+        str(exe),
+        "--seed",
+        "5",
+        "--out",
+        str(tmp_path / "o"),
+        "--quiet",
+        "--no-plots",
+    )
+    assert r.returncode == 0, r.stderr
+    assert "attempt 1 failed" in r.stderr and "Segmentation fault" in r.stderr
+    run = Path(r.stdout.strip())
+    rec = json.loads((run / "run.json").read_text())
+    attempts = rec["details"]["attempts"]
+    assert [a["ok"] for a in attempts] == [False, True]
+    assert attempts[1]["settings"]["RandomSeed"] != "5"
+    assert "TrackTolBeforeEG: 1e-07;" in (run / "input").read_text()
+    assert (run / "failed-attempt-1" / "input").is_file()
 
 
 @pytest.mark.parametrize("case", ["case1", "case2", "case3"])

@@ -3,10 +3,11 @@
 `assign_branches` joins the solutions of neighbouring sweep points into branches: a secant
 predictor from each branch's last two points, then a one-to-one minimum-cost assignment (the
 Hungarian algorithm) on the complex solver coordinates, so a branch goes on through a fold where
-two real solutions become a complex-conjugate pair. `find_events` reads the branches for folds,
-stability changes and physical changes, and refines each one's parameter value: a fold by Newton
-on the augmented system F(x, p) = 0, J_x(x, p) v = 0, r.v = 1 in (x, v, p); the others by
-bisection along the branch, Newton-correcting the branch point at each midpoint.
+two real solutions become a complex-conjugate pair. `find_events` reads the branches for folds
+(and pitchforks: a pair meeting on a third branch), stability changes and physical changes, and
+refines each one's parameter value: a fold by Newton on the augmented system F(x, p) = 0,
+J_x(x, p) v = 0, r.v = 1 in (x, v, p); the others by bisection along the branch,
+Newton-correcting the branch point at each midpoint.
 """
 
 from __future__ import annotations
@@ -300,7 +301,8 @@ def find_events(
     |eigenvalue| / max |eigenvalue| of the energy Hessian there; physical change: the larger of
     |d_i| and the relative |F| there), bracket (the accuracy of the value:
     last Newton step or bracket width), description, lo and hi (the sweep points around it), and
-    the point itself: variables, x and (folds) the null vector v of J_x.
+    the point itself: variables, x and (folds) the null vector v of J_x. `seed` is used only
+    for a fresh solve where Newton cannot follow a branch during a bisection.
     """
     sw = sweep_with_branches
     base = base_params.as_dict() if isinstance(base_params, Params) else dict(base_params)
@@ -511,7 +513,7 @@ def _along_branch_events(ctx: _Ctx, b: int) -> list[dict]:
             return float(_hessian_eigs(ctx.st, value, variables, x)[j])
 
         p, x, width, ok, val = _bisect(ctx, b, eig)
-        size = np.abs(_hessian_eigs(ctx.st, p, variables, x)).max()
+        size = max(np.abs(_hessian_eigs(ctx.st, p, variables, x)).max(), 1e-300)
         out.append(
             ctx.event(
                 "stability_change",

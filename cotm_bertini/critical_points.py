@@ -31,12 +31,17 @@ def newton_on_gradient(
     return np.mod(g, 2 * np.pi)
 
 
-def critical_points(params: Params, grid: int = 48, tol: float = 1e-9) -> pd.DataFrame:
-    """Distinct critical points of V with |grad V| < tol k L3^2, classified by the Hessian."""
+def critical_points(params: Params, grid: int = 48, tol: float = 1e-10) -> pd.DataFrame:
+    """Distinct critical points of V with |grad V| < tol min(k) L3^2, classified by the Hessian.
+
+    Damped Newton from every grid point, then undamped Newton steps to polish: the tolerance is
+    relative to the weaker spring, so a very stiff spring cannot hide an unconverged point.
+    """
     axis = (np.arange(grid) + 0.5) * 2 * np.pi / grid
     starts = np.stack(np.meshgrid(axis, axis, indexing="ij"), axis=-1).reshape(-1, 2)
     g = newton_on_gradient(params, starts)
-    scale = max(params.k1, params.k2) * params.L3**2
+    g = newton_on_gradient(params, g, iterations=8, max_step=np.inf)
+    scale = min(params.k1, params.k2) * params.L3**2
     grad = energy_gradient(params, g[:, 0], g[:, 1])
     good = np.isfinite(grad).all(axis=1) & (np.abs(grad).max(axis=1) < tol * scale)
     # Exclude the cusps where a spring with L0 > 0 has zero length: V is not smooth there.

@@ -180,3 +180,17 @@ def spring_vectors_cs(params: Params, c1, s1, c2, s2) -> dict:
         "spring2": p5 - np.array([p.p3x, p.p3y]),
         "rod": p4,
     }
+
+
+LENGTHS = ("L3", "p2x", "p3x", "p3y", "p6x", "p5x", "p5y", "L01", "L02")
+
+
+def normalized(params: Params) -> Params:
+    """The same mechanism in units of L3 (lengths) and max(k1, k2) (stiffness).
+
+    Its equilibria have the same angles; its spring lengths are the originals divided by L3.
+    """
+    k = max(params.k1, params.k2)
+    return Params(
+        **{n: v / (params.L3 if n in LENGTHS else k) for n, v in params.as_dict().items()}
+    )

@@ -22,15 +22,16 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .geometry import Params, spring_vectors_cs
+from .geometry import Params, normalized, spring_vectors_cs
 from .parse import METADATA_COLUMNS
 from .polynomial import ParametricSystem
 from .render import render_parameter_homotopy, render_system
 
 # Magnitudes of the generic start parameters (random complex, this size).
-_START_SCALE = {"L3": 9.0, "k1": 3.0, "k2": 3.0, "L01": 10.0, "L02": 10.0}
+_START_SCALE: dict[str, float] = {}  # targets are normalised (homotopy.normalized): all ~1
 _SUCCESS = "Success"
 DOUBLE_FINAL_TOLERANCE = "1e-8"
+DOUBLE_MAX_STEPS = 2000
 
 
 class HomotopyError(RuntimeError):
@@ -147,7 +148,7 @@ def _solve_generic(ps: ParametricSystem, seed: int, key: str) -> GenericSet:
     start = {}
     for name in ps.parameters:
         z = complex(*rng.normal(size=2)) / np.sqrt(2)
-        start[name] = _START_SCALE.get(name, 4.0) * z
+        start[name] = _START_SCALE.get(name, 1.0) * z
     system = ps.instantiate([start[n] for n in ps.parameters])
     bertini.random.set_random_seed(seed)
     t0 = time.perf_counter()
@@ -214,6 +215,9 @@ def _track(
         # The endgame cannot reach Bertini's default 1e-11 in double precision on a few paths
         # and fails them; 1e-8 is enough, as classification Newton-refines every endpoint.
         solver.set(final_tolerance=DOUBLE_FINAL_TOLERANCE)
+        # In double precision a path whose step was cut can crawl for 1e5 steps (tens of
+        # seconds); a normal path takes under a hundred. Give up early: AMP redoes it in ms.
+        solver.set(max_num_steps=DOUBLE_MAX_STEPS)
     solver.solve(show_progress=False)
     return solver.solution_metadata(), solver.all_solutions()
 
@@ -364,8 +368,13 @@ def solve_target(
     arrive than the generic count, the point is tracked again from a second, independent generic
     set (a new random start, like Paramotopy's new gamma); if that does not settle it, the target
     is solved ab initio. `info["method"]` says which, `info["lost"]` how many paths were lost.
+
+    The target is solved in units of L3 and max(k1, k2) (equilibria do not change when every
+    length, or every stiffness, is scaled), so the paths see numbers of order one whatever the
+    user's units; the spring lengths are scaled back.
     """
     gs = generic_set(ps, seed)
+    raw, params, length = params, normalized(params), params.L3
     endpoints, rep = track(ps, gs, params, threads=threads)
     method = "parameter homotopy" + (" + adaptive retrack" if rep.retracked_adaptive else "")
     if rep.lost or rep.finite < len(gs.points):
@@ -379,14 +388,18 @@ def solve_target(
         else:
             endpoints = ab_initio(ps, params, seed)
             method = "ab initio (both parameter homotopies lost paths)"
+    for v in ps.variables:
+        if v.startswith("d"):
+            endpoints[v] = endpoints[v] * length
     info = {
         **rep.as_dict(),
         "method": method,
+        "units": {"length": length, "stiffness": max(raw.k1, raw.k2)},
         "generic_key": gs.key,
         "generic_paths": gs.paths,
         "generic_finite": gs.finite_endpoints,
     }
-    allpoints = pd.concat([endpoints, zero_length_roots(params, ps.variables)], ignore_index=True)
+    allpoints = pd.concat([endpoints, zero_length_roots(raw, ps.variables)], ignore_index=True)
     return allpoints, info
 
 

@@ -95,7 +95,7 @@ def solve_in(
     with t.stage("parse"):
         out = read_output(folder)
     with t.stage("classify"):
-        table = classify(params, system, out.endpoints, out.variables, tolerances)
+        table = classify(params, out.endpoints, out.variables, tolerances)
     tracked = run.paths_tracked
     if tracked is None and settings.variable_groups == "total_degree":
         tracked = system.total_degree
@@ -147,7 +147,7 @@ def _solve_homotopy(
     with t.stage("solve"):
         endpoints, info = solve_target(ps, params, settings.seed, threads=settings.threads)
     with t.stage("classify"):
-        table = classify(params, system, endpoints, ps.variables, tolerances)
+        table = classify(params, endpoints, ps.variables, tolerances)
     out = BertiniOutput("in-process", ps.variables, endpoints, len(endpoints), None)
     eng = engine_mod.Engine("bertini module (in-process)", "homotopy", gs.bertini_version, {})
     details = {

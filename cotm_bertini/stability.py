@@ -7,8 +7,8 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from .compiled import energy, energy_hessian, tan_half_jacobian
-from .geometry import Params, spring_vectors_cs
+from .compiled import energy, energy_hessian, polynomial_system, tan_half_jacobian
+from .geometry import Params, normalized, spring_vectors_cs
 from .polynomial import PolySystem
 
 
@@ -84,13 +84,20 @@ def spring_vectors(params: Params, g1: np.ndarray, g2: np.ndarray) -> dict[str, 
 
 def classify(
     params: Params,
-    system: PolySystem,
     endpoints: pd.DataFrame,
     variables: tuple[str, ...],
     tol: Tolerances = Tolerances(),
 ) -> pd.DataFrame:
-    """One row per distinct finite solution with the solutions.csv columns (see README)."""
+    """One row per distinct finite solution with the solutions.csv columns (see README).
+
+    The numerics (Newton refinement, condition numbers, merging, realness) run in units of L3
+    and max(k1, k2), where every quantity is of order one whatever the user's units.
+    """
+    length = params.L3
+    system = polynomial_system(normalized(params))
+    is_d = np.array([v.startswith("d") for v in variables])
     x0 = endpoints[list(variables)].to_numpy(dtype=complex)
+    x0 = np.where(is_d, x0 / length, x0)
     cond = endpoints["condition_number"].to_numpy(dtype=float)
     acc = endpoints["accuracy_estimate"].fillna(0.0).to_numpy(dtype=float)
     x, res = newton_refine(system, x0, 0 if len(x0) == 0 else tol.newton_steps)
@@ -125,10 +132,12 @@ def classify(
     best = np.array([r["best"] for r in rows])
     pts = x[best]
     absres = np.abs(system.evaluate(pts)).max(axis=1)
+    pts = np.where(is_d, pts * length, pts)
     v = {name: pts[:, k] for k, name in enumerate(variables)}
     gam1 = complex_angles(v["c1"], v["s1"])
     gam2 = complex_angles(v["c2"], v["s2"])
-    max_imag = (np.abs(pts.imag) / (1.0 + np.abs(pts.real))).max(axis=1)
+    unit = np.where(is_d, length, 1.0)
+    max_imag = (np.abs(pts.imag) / (unit + np.abs(pts.real))).max(axis=1)
     sing = np.array([r["singular"] for r in rows])
     # A singular root is known to about sqrt(accuracy) only: so is its imaginary part.
     loose = np.minimum(10.0 * np.sqrt([max(r["accuracy"], 1e-16) for r in rows]), 1e-4)

@@ -101,9 +101,7 @@ def solve_point(
     params = Params(**{**base, **values})
     ps = parametric_system(params.zfl)
     endpoints, info = solve_target(ps, params, seed, threads=threads)
-    table = classify(
-        params, ps.instantiate([getattr(params, n) for n in ps.parameters]), endpoints, ps.variables
-    )
+    table = classify(params, endpoints, ps.variables)
     table.insert(0, "point", -1)
     for k, name in enumerate(values):
         table.insert(1 + k, name, values[name])

@@ -90,7 +90,7 @@ def _phc(params: Params, solutions: pd.DataFrame, seed: int) -> RouteResult:
         run = solve_phc(system, seed=seed)
     except PhcError as exc:
         return RouteResult("PHCpack phc -b", "failed", False, float("nan"), 0.0, str(exc))
-    table = classify(params, system, run.endpoints, system.variables)
+    table = classify(params, run.endpoints, system.variables)
     c = compare_sets(table, solutions, tol=1e-3)
     ok = (
         c.only_resultant == 0

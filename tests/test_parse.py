@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 
 from cotm_bertini.engine import find_engine
-from cotm_bertini.equations import polynomial_system
 from cotm_bertini.geometry import make_params
 from cotm_bertini.parse import ParseError, read_output, read_solution_list
 from cotm_bertini.solver import run_bertini
@@ -33,7 +32,7 @@ def test_bertini16_fixtures(fixtures_dir, case):
     for p in finite:
         assert np.abs(pts - p).max(axis=1).min() < 1e-9
     params = make_params(case)
-    table = classify(params, polynomial_system(params), out.endpoints, out.variables)
+    table = classify(params, out.endpoints, out.variables)
     assert len(table) == distinct
     assert int(table["is_real"].sum()) == real
     assert table["multiplicity"].sum() == endpoints
@@ -50,9 +49,8 @@ def test_fresh_bertini2_run_has_same_table_shape(fixtures_dir, tmp_path):
     assert list(b2.endpoints.columns) == list(b1.endpoints.columns)
     assert dict(b2.endpoints.dtypes) == dict(b1.endpoints.dtypes)
     params = make_params("case1")
-    system = polynomial_system(params)
-    t1 = classify(params, system, b1.endpoints, b1.variables)
-    t2 = classify(params, system, b2.endpoints, b2.variables)
+    t1 = classify(params, b1.endpoints, b1.variables)
+    t2 = classify(params, b2.endpoints, b2.variables)
     assert list(t1.columns) == list(t2.columns)
     assert len(t1) == len(t2) == 6
     for a, b in zip(t1.itertuples(), t2.itertuples(), strict=True):

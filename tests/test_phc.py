@@ -52,7 +52,7 @@ def _phc(case: str, seed: int = PHC_SEED):
     params = make_params(case)
     system = polynomial_system(params)
     result = phc.solve_phc(system, timeout=300, seed=seed)
-    table = classify(params, system, result.endpoints, system.variables)
+    table = classify(params, result.endpoints, system.variables)
     return params, system, result, table
 
 

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from conftest import solved
 
-from cotm_bertini.equations import polynomial_system
 from cotm_bertini.geometry import make_params
 from cotm_bertini.paper import K_RATIO, TABLES
 from cotm_bertini.parse import read_output
@@ -18,7 +17,7 @@ def _fixture_scenario(fixtures_dir) -> Scenario:
         p = make_params(case)
         out = read_output(fixtures_dir / case)
         params[case] = p
-        tables[case] = classify(p, polynomial_system(p), out.endpoints, out.variables)
+        tables[case] = classify(p, out.endpoints, out.variables)
         paths[case] = {"case1": 8, "case2": 48, "case3": 192}[case]
     return Scenario("Bertini 1.6 fixtures, Table 1", params, tables, paths)
 

@@ -5,7 +5,7 @@ BIN     := $(VENV)/bin
 STAMP   := $(VENV)/.installed
 CLI     := $(BIN)/cotm-bertini
 
-.PHONY: install phcpack case1 case2 case3 test verify paper lint format clean-runs
+.PHONY: install phcpack case1 case2 case3 test stress sweep bench verify paper lint format clean-runs
 
 $(STAMP): pyproject.toml
 	@$(PY) -c 'import venv, ensurepip' 2>/dev/null || { \
@@ -34,6 +34,17 @@ verify: $(STAMP) phcpack
 
 paper: $(STAMP)
 	$(CLI) paper --out runs/paper
+
+# The paper's sweep (Figs 5-6): L01 from 0 to 12 m at 241 points, L02 = 0, Table 1.
+sweep: $(STAMP)
+	$(CLI) sweep --param L01 --from 0 --to 12 --points 241 --out runs
+
+# The full stress set (200 random geometries, 20 seeds); `make test` runs a fast subset.
+stress: $(STAMP) phcpack
+	COTM_STRESS=full $(BIN)/pytest -q tests/stress
+
+bench: $(STAMP) phcpack
+	$(BIN)/python bench/run_all.py
 
 lint: $(STAMP)
 	$(BIN)/ruff check cotm_bertini tests

@@ -185,13 +185,7 @@ def _sweep(args: argparse.Namespace) -> int:
         spec = load_spec(Path(args.resume))
         folder = prepare(spec, Path(args.out), resume=Path(args.resume))
     else:
-        overrides: dict[str, float] = {}
-        if args.params:
-            overrides.update(load_toml(args.params))
-        for text in args.set:
-            name, value = parse_assignment(text)
-            overrides[name] = value
-        base = make_params(None, overrides).as_dict()
+        base = make_params(None, _overrides(args)).as_dict()
         spec = SweepSpec(
             base,
             args.param,
@@ -259,14 +253,19 @@ def _settings(args: argparse.Namespace) -> Settings:
     )
 
 
-def _params(args: argparse.Namespace):
+def _overrides(args: argparse.Namespace) -> dict[str, float]:
+    """--params FILE.toml, then each --set NAME=VALUE."""
     overrides: dict[str, float] = {}
     if args.params:
         overrides.update(load_toml(args.params))
     for text in args.set:
         name, value = parse_assignment(text)
         overrides[name] = value
-    return make_params(args.case, overrides)
+    return overrides
+
+
+def _params(args: argparse.Namespace):
+    return make_params(args.case, _overrides(args))
 
 
 def _summary(solved, folder: Path, record: dict) -> str:

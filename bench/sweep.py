@@ -41,7 +41,7 @@ def main() -> None:
         params = make_params(None, {**TABLE1, "L01": float(v)})
         with tempfile.TemporaryDirectory(prefix="bench-fresh-") as tmp:
             t = time.perf_counter()
-            solve_in(Path(tmp) / "run", params, Settings(seed=1))
+            solve_in(Path(tmp) / "run", params, Settings(seed=1, engine="cli"))
             fresh.append(time.perf_counter() - t)
     fresh_mean = float(np.mean(fresh))
 
@@ -50,8 +50,10 @@ def main() -> None:
     print(f"  sweep wall time:                {stats['seconds']:8.2f} s   (target < 60 s)")
     print(f"  per point (wall / points):      {per_point * 1e3:8.1f} ms")
     print(f"  lost paths:                     {stats['lost_paths']:8d}")
-    print(f"  fresh bertini2 solve per point: {fresh_mean * 1e3:8.1f} ms "
-          f"(mean of {len(fresh)}, full pipeline, 2 threads)")
+    print(
+        f"  fresh bertini2 solve per point: {fresh_mean * 1e3:8.1f} ms "
+        f"(mean of {len(fresh)}, full pipeline, 2 threads)"
+    )
     print(f"  ratio fresh / sweep point:      {fresh_mean / per_point:8.1f} x  (target >= 10 x)")
 
 

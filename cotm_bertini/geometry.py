@@ -194,3 +194,42 @@ def normalized(params: Params) -> Params:
     return Params(
         **{n: v / (params.L3 if n in LENGTHS else k) for n, v in params.as_dict().items()}
     )
+
+
+def zero_length_points(params: Params, variables: tuple[str, ...]) -> list[list[complex]]:
+    """Solver-variable points where a spring with L0 > 0 has zero length (the d = 0 artefacts).
+
+    For spring i: P4 = L3 (c1, s1) on the unit circle with |a - P4| = |q| (a, q: the spring's
+    anchors in frames B and T), then R(gamma2) q = a - P4 gives (c2, s2); d_i = 0 and the other
+    spring's d_j = +-sqrt(|P_j|^2) (complex square root of the sum of squares). Complex ones
+    included; each is a double root of the multiplied-through system.
+    """
+    import numpy as np
+
+    out = []
+    anchors = {
+        1: ((params.p2x, 0.0), (params.p6x, 0.0)),
+        2: ((params.p3x, params.p3y), (params.p5x, params.p5y)),
+    }
+    for i in (1, 2):
+        if f"d{i}" not in variables:
+            continue
+        a, q = (np.array(v, dtype=complex) for v in anchors[i])
+        norm_a = np.sqrt(a @ a)
+        e = a / norm_a
+        e_perp = np.array([-e[1], e[0]])
+        alpha = ((a @ a) + params.L3**2 - q @ q) / (2 * params.L3 * norm_a)
+        for beta in (np.sqrt(1 - alpha**2 + 0j), -np.sqrt(1 - alpha**2 + 0j)):
+            u = alpha * e + beta * e_perp
+            w = a - params.L3 * u
+            c2 = (q @ w) / (q @ q)
+            s2 = (q[0] * w[1] - q[1] * w[0]) / (q @ q)
+            point = {"c1": u[0], "s1": u[1], "c2": c2, "s2": s2, f"d{i}": 0j}
+            j = 3 - i
+            if f"d{j}" in variables:
+                vec = spring_vectors_cs(params, u[0], u[1], c2, s2)[f"spring{j}"]
+                dj = np.sqrt(vec @ vec)
+                out += [[{**point, f"d{j}": sign * dj}[v] for v in variables] for sign in (1, -1)]
+            else:
+                out.append([point[v] for v in variables])
+    return out

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .geometry import Params, normalized, spring_vectors_cs
+from .geometry import Params, normalized, zero_length_points
 from .parse import METADATA_COLUMNS
 from .polynomial import ParametricSystem
 from .render import render_parameter_homotopy, render_system
@@ -313,33 +313,8 @@ def zero_length_roots(params: Params, variables: tuple[str, ...]) -> pd.DataFram
     the other spring's d_j = +-sqrt(|P_j|^2) (complex square root of the sum of squares). Each is
     a double root of the multiplied-through system (two paths end there).
     """
-    rows = []
-    anchors = {
-        1: ((params.p2x, 0.0), (params.p6x, 0.0)),
-        2: ((params.p3x, params.p3y), (params.p5x, params.p5y)),
-    }
-    for i in (1, 2):
-        if f"d{i}" not in variables:
-            continue
-        a, q = (np.array(v, dtype=complex) for v in anchors[i])
-        na_ = np.sqrt(a @ a)
-        e = a / na_
-        e_perp = np.array([-e[1], e[0]])
-        alpha = ((a @ a) + params.L3**2 - q @ q) / (2 * params.L3 * na_)
-        for beta in (np.sqrt(1 - alpha**2 + 0j), -np.sqrt(1 - alpha**2 + 0j)):
-            u = alpha * e + beta * e_perp
-            w = a - params.L3 * u
-            c2 = (q @ w) / (q @ q)
-            s2 = (q[0] * w[1] - q[1] * w[0]) / (q @ q)
-            point = {"c1": u[0], "s1": u[1], "c2": c2, "s2": s2, f"d{i}": 0j}
-            j = 3 - i
-            if f"d{j}" in variables:
-                vec = spring_vectors_cs(params, u[0], u[1], c2, s2)[f"spring{j}"]
-                dj = np.sqrt(vec @ vec)
-                for sign in (1, -1):
-                    rows.append({**point, f"d{j}": sign * dj})
-            else:
-                rows.append(point)
+    points = zero_length_points(params, variables)
+    rows = [dict(zip(variables, p, strict=True)) for p in points]
     frame = pd.DataFrame(
         {
             "path_number": -1,

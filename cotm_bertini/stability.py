@@ -8,7 +8,7 @@ import numpy as np
 import pandas as pd
 
 from .compiled import energy, energy_hessian, polynomial_system, tan_half_jacobian
-from .geometry import Params, normalized, spring_vectors_cs
+from .geometry import Params, normalized, spring_vectors_cs, zero_length_points
 from .polynomial import PolySystem
 
 
@@ -25,6 +25,7 @@ class Tolerances:
     merge: float = 1e-8  # nonsingular endpoints closer than this (relative) are one solution
     hessian: float = 1e-9  # eigenvalues within this (relative to k L3^2) of 0: degenerate
     newton_steps: int = 3
+    snap: float = 1e-3  # an endpoint this close (units of L3) to a d = 0 artefact is that artefact
 
 
 def newton_refine(system: PolySystem, x: np.ndarray, steps: int) -> tuple[np.ndarray, np.ndarray]:
@@ -72,6 +73,27 @@ def cluster_endpoints(
     return labels
 
 
+def _snap_zero_length(
+    params: Params, variables: tuple[str, ...], x: np.ndarray, tol: Tolerances
+) -> tuple[np.ndarray, np.ndarray]:
+    """Put endpoints that sit on a d = 0 artefact exactly there (normalised units).
+
+    An endgame only reaches such a double root to about the square root of its tolerance, and
+    its two paths may end apart; the closed form knows the point exactly.
+    """
+    snapped = np.zeros(len(x), dtype=bool)
+    exact = zero_length_points(normalized(params), variables)
+    if not exact or not len(x):
+        return x, snapped
+    x = x.copy()
+    for point in np.array(exact, dtype=complex):
+        gap = np.abs(x - point).max(axis=1)
+        near = gap < tol.snap
+        x[near] = point
+        snapped |= near
+    return x, snapped
+
+
 def complex_angles(c: np.ndarray, s: np.ndarray) -> np.ndarray:
     """gamma = -i log(c + i s), in degrees: real for points on the real circle."""
     return (-1j * np.log(c + 1j * s)) * (180.0 / np.pi)
@@ -100,14 +122,17 @@ def classify(
     x0 = np.where(is_d, x0 / length, x0)
     cond = endpoints["condition_number"].to_numpy(dtype=float)
     acc = endpoints["accuracy_estimate"].fillna(0.0).to_numpy(dtype=float)
+    x0, snapped = _snap_zero_length(params, variables, x0, tol)
     x, res = newton_refine(system, x0, 0 if len(x0) == 0 else tol.newton_steps)
     # Our own condition number at the refined point: Bertini's estimate is taken wherever its
     # endgame stopped and varies by orders of magnitude between runs near a singular root.
     jac_cond = np.linalg.cond(system.jacobian(x)) if len(x) else np.zeros(0)
     jac_cond = np.where(np.isfinite(jac_cond), jac_cond, np.inf)
-    singular = (jac_cond > tol.singular_condition) | (
-        endpoints["bertini_multiplicity"] > 1
-    ).to_numpy()
+    singular = (
+        (jac_cond > tol.singular_condition)
+        | (endpoints["bertini_multiplicity"] > 1).to_numpy()
+        | snapped
+    )
     labels = cluster_endpoints(x, singular, acc, tol.merge)
 
     rows = []

@@ -148,10 +148,16 @@ def _parse_bertini2(text: str, where: str) -> tuple[tuple[str, ...], list[dict]]
     names = lines[1].split()
     if len(names) != n:
         raise ParseError(f"{where}: {n} variables announced, {len(names)} named")
-    hom = [i for i, v in enumerate(names) if v.startswith("HOM_VAR")]
-    user = [i for i, v in enumerate(names) if not v.startswith("HOM_VAR")]
-    if len(hom) != 1:
-        raise ParseError(f"{where}: expected one homogenizing variable, found {len(hom)}")
+    # Each variable group has its own homogenizing variable, listed just before the group.
+    owner, current = {}, None
+    for i, v in enumerate(names):
+        if v.startswith("HOM_VAR"):
+            current = i
+        elif current is None:
+            raise ParseError(f"{where}: variable {v} comes before any homogenizing variable")
+        else:
+            owner[i] = current
+    user = sorted(owner)
     variables = tuple(names[i] for i in user)
     records, i = [], 2
     while True:
@@ -181,8 +187,9 @@ def _parse_bertini2(text: str, where: str) -> tuple[tuple[str, ...], list[dict]]
         while j < len(lines) and not lines[j].strip():
             j += 1
         raw = [_complex(lines[j + k], f"{where}:{j + k + 1}") for k in range(n)]
-        h = raw[hom[0]]
-        rec["coords"] = [raw[k] / h if h != 0 else complex("nan") for k in user]
+        rec["coords"] = [
+            raw[k] / raw[owner[k]] if raw[owner[k]] != 0 else complex("nan") for k in user
+        ]
         records.append(rec)
         i = j + n
     return variables, records
@@ -203,6 +210,20 @@ def read_output(folder: Path) -> BertiniOutput:
     coords = np.array([r.pop("coords") for r in records], dtype=complex).reshape(
         len(records), len(variables)
     )
+    if len(records) > len(finite):
+        # With SecurityLevel 1, main_data also lists the endpoints at infinity: keep the ones
+        # Bertini itself calls finite.
+        keep = [
+            k
+            for k in range(len(records))
+            if np.isfinite(coords[k]).all()
+            and len(finite)
+            and (
+                np.abs(finite - coords[k]).max(axis=1) <= 1e-6 * (1 + np.abs(coords[k]).max())
+            ).any()
+        ]
+        records = [records[k] for k in keep]
+        coords = coords[keep]
     if len(records) != len(finite):
         raise ParseError(
             f"{folder}: main_data has {len(records)} finite endpoints, "

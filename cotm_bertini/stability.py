@@ -191,7 +191,9 @@ def classify(
     zero = np.zeros(len(rows), dtype=bool)
     for i in (1, 2):
         if f"d{i}" in v:
-            zero |= sing & (np.abs(v[f"d{i}"]) < tol.zero_length * params.L3)
+            # d = 0 with L0 > 0 is never an equilibrium (the force direction is undefined):
+            # the double roots where one spring collapses, and the complex points where both do.
+            zero |= np.abs(v[f"d{i}"]) < tol.zero_length * params.L3
     negative = is_real & ((d[1] <= 0) | (d[2] <= 0)) & ~zero
     frame["reason"] = np.select(
         [zero, ~is_real, negative], ["zero_length_spring", "complex", "negative_d"], default=""

@@ -70,3 +70,25 @@ def test_malformed_files_raise(fixtures_dir, tmp_path):
     (folder / "main_data").write_text("garbage\n")
     with pytest.raises(ParseError, match="layout"):
         read_output(folder)
+
+
+@pytest.mark.parametrize(
+    "settings",
+    [{"security_level": 1}, {"variable_groups": "multihomogeneous"}],
+    ids=["SecurityLevel-1", "multihomogeneous"],
+)
+def test_bertini2_output_variants_parse_to_the_same_solutions(settings):
+    """main_data with endpoints at infinity (SecurityLevel 1) or one homogenizing variable per
+    variable group (multihomogeneous start) gives the same case-2 solutions as the default."""
+    from cotm_bertini.pipeline import solve
+    from cotm_bertini.settings import Settings
+
+    params = make_params("case2")
+    ref = solve(params, Settings(engine="cli"))
+    other = solve(params, Settings(engine="cli", **settings))
+    assert len(other) == len(ref) == 22
+    for col in ("is_real", "physical", "stable"):
+        assert other[col].sum() == ref[col].sum()
+    a = ref.loc[ref["physical"], ["gamma1_deg", "gamma2_deg"]].to_numpy()
+    b = other.loc[other["physical"], ["gamma1_deg", "gamma2_deg"]].to_numpy()
+    assert np.abs(a - b).max() < 1e-8

@@ -301,10 +301,19 @@ COLUMNS = [
 
 
 def _order(frame: pd.DataFrame) -> pd.DataFrame:
-    # Physical first, then real, then complex; within each by angle, so ids are stable.
+    # Physical first, then real, then complex; within each by angle, so ids are stable. Angles
+    # are rounded to 1e-9 deg so that a conjugate pair (equal real parts up to rounding) is
+    # always ordered by its imaginary part, whichever run produced it.
     key = np.where(frame["physical"], 0, np.where(frame["is_real"], 1, 2))
-    frame = frame.assign(_k=key).sort_values(["_k", "gamma1_deg", "gamma2_deg"], kind="stable")
-    frame = frame.drop(columns="_k").reset_index(drop=True)
+    sort = frame.assign(
+        _k=key,
+        _g1=np.round(frame["gamma1_deg"].to_numpy(), 9) % 360.0,
+        _g2=np.round(frame["gamma2_deg"].to_numpy(), 9) % 360.0,
+        _i1=np.round(frame["gamma1_imag_deg"].to_numpy(), 9),
+        _i2=np.round(frame["gamma2_imag_deg"].to_numpy(), 9),
+    )
+    cols = ["_k", "_g1", "_g2", "_i1", "_i2"]
+    frame = sort.sort_values(cols, kind="stable").drop(columns=cols).reset_index(drop=True)
     frame["solution_id"] = np.arange(1, len(frame) + 1)
     rest = [c for c in frame.columns if c not in COLUMNS]
     return frame[COLUMNS + rest]

@@ -21,7 +21,6 @@ import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 from benchlib import match, median, run_bertini2, show, write_csv
 
@@ -89,7 +88,7 @@ def zero_dim_solver(params) -> tuple[float, pd.DataFrame, str]:
     from bertini import nag_algorithm as na
 
     from cotm_bertini.compiled import polynomial_system
-    from cotm_bertini.parse import METADATA_COLUMNS
+    from cotm_bertini.homotopy import endpoint_row, endpoints_frame
     from cotm_bertini.render import render_system
 
     bertini.recording(False)
@@ -105,26 +104,8 @@ def zero_dim_solver(params) -> tuple[float, pd.DataFrame, str]:
         for i, m in enumerate(meta)
         if m.is_finite and str(m.endgame_success_code).endswith("Success")
     ]
-    rows = []
-    for i in keep:
-        d = meta[i].to_dict()
-        rows.append(
-            {
-                "path_number": i,
-                "condition_number": float(d["condition_number"]),
-                "function_residual": float(d["function_residual"]),
-                "newton_residual": float(d["newton_residual"]),
-                "final_t": complex(d["final_time_used"]).real,
-                "max_precision": float(d["max_precision_used"]),
-                "accuracy_estimate": float(d["accuracy_estimate_user_coords"]),
-                "cycle_number": int(d["cycle_num"]),
-                "bertini_multiplicity": int(d["multiplicity"]),
-            }
-        )
-    frame = pd.DataFrame(rows, columns=list(METADATA_COLUMNS))
-    coords = np.array([[complex(z) for z in pts[i]] for i in keep], dtype=complex)
-    for k, v in enumerate(system.variables):
-        frame[v] = coords[:, k]
+    rows = [endpoint_row(i, meta[i], pts[i]) for i in keep]
+    frame = endpoints_frame(system.variables, rows)
     return seconds, frame, f"{len(meta)} paths, {len(keep)} finite"
 
 

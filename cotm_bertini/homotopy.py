@@ -251,7 +251,7 @@ def track(
         m, p = results[i]
         code = _code(m)
         if code == _SUCCESS and m.is_finite:
-            rows.append(_row(i, m, p))
+            rows.append(endpoint_row(i, m, p))
         elif code in ("GoingToInfinity", "SecurityMaxNormReached") or not m.is_finite:
             rep.infinite += 1
         else:
@@ -259,10 +259,10 @@ def track(
             rep.notes.append(f"path {i}: {code}")
     rep.finite = len(rows)
     rep.seconds = time.perf_counter() - t0
-    return _frame(ps.variables, rows), rep
+    return endpoints_frame(ps.variables, rows), rep
 
 
-def _row(index: int, m, point) -> dict:
+def endpoint_row(index: int, m, point) -> dict:
     """One endpoint's metadata (parse.METADATA_COLUMNS) and coordinates."""
     d = m.to_dict()
     return {
@@ -295,7 +295,7 @@ def _crossing(results: dict, idx: list[int], tol: float = 1e-7) -> bool:
     return False
 
 
-def _frame(variables: tuple[str, ...], rows: list[dict]) -> pd.DataFrame:
+def endpoints_frame(variables: tuple[str, ...], rows: list[dict]) -> pd.DataFrame:
     coords = np.array([r.pop("coords") for r in rows], dtype=complex).reshape(
         len(rows), len(variables)
     )
@@ -391,10 +391,10 @@ def ab_initio(ps: ParametricSystem, params: Params, seed: int) -> pd.DataFrame:
     solver = na.ZeroDimSolver(bertini.parse.system(render_system(system)))
     solver.solve(show_progress=False)
     rows = [
-        _row(i, m, p)
+        endpoint_row(i, m, p)
         for i, (m, p) in enumerate(
             zip(solver.solution_metadata(), solver.all_solutions(), strict=True)
         )
         if m.is_finite and _code(m) == _SUCCESS and not m_singular(m)
     ]
-    return _frame(ps.variables, rows)
+    return endpoints_frame(ps.variables, rows)

@@ -23,8 +23,10 @@ phcpack:
 	  echo "installing Debian phcpack"; \
 	  apt-get update -qq && apt-get install -y -qq phcpack >/dev/null; }
 
+# The cli engine keeps Bertini's own output files in the run folder for inspection;
+# `cotm-bertini solve` without --engine uses the faster in-process parameter homotopy.
 case1 case2 case3: $(STAMP)
-	$(CLI) solve $@
+	$(CLI) solve $@ --engine cli
 
 test: $(STAMP) phcpack
 	$(BIN)/pytest -q

@@ -169,6 +169,7 @@ def main() -> int:
         )
     section("peers", peers.run, ref)
     section("stages", stage_profile.run)
+    section("stages_cli", stage_profile.run, engine="cli")  # what `make case3` runs
     section("sweep", sweep_time)
     if "sweep" in results:
         s = results["sweep"]

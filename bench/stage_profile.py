@@ -22,16 +22,16 @@ from pathlib import Path
 import pandas as pd
 from benchlib import median, show, write_csv
 
-STAGES = ("derive", "generic", "render", "solve", "classify", "write", "plot", "total")
+STAGES = ("derive", "generic", "render", "solve", "parse", "classify", "write", "plot", "total")
 REPEATS = 3
 
 
-def one_run(out: Path) -> dict[str, float]:
+def one_run(out: Path, engine: str) -> dict[str, float]:
     """One `make case3`-like solve: stage seconds from run.json, wall and start-up."""
     exe = str(Path(sys.executable).with_name("cotm-bertini"))
     start = time.perf_counter()
     proc = subprocess.run(
-        [exe, "solve", "case3", "--no-cache", "--out", str(out)],
+        [exe, "solve", "case3", "--no-cache", "--engine", engine, "--out", str(out)],
         capture_output=True,
         text=True,
         check=True,
@@ -56,10 +56,14 @@ def interpreter_start(repeats: int = REPEATS) -> float:
     return median(walls)
 
 
-def run(repeats: int = REPEATS) -> pd.DataFrame:
-    """The stage table: printed, written to stage_profile.csv, returned (one row per stage)."""
+def run(repeats: int = REPEATS, engine: str = "homotopy") -> pd.DataFrame:
+    """The stage table: printed, written to stage_profile[-cli].csv, returned (a row a stage).
+
+    engine "cli" is what `make case3` runs (the bertini2 command, its files kept); "homotopy" is
+    the default of `cotm-bertini solve`.
+    """
     with tempfile.TemporaryDirectory(prefix="bench-stages-") as tmp:
-        runs = [one_run(Path(tmp) / str(k)) for k in range(repeats)]
+        runs = [one_run(Path(tmp) / str(k), engine) for k in range(repeats)]
     bare = interpreter_start()
     names = list(runs[0])
     table = pd.DataFrame(
@@ -72,8 +76,8 @@ def run(repeats: int = REPEATS) -> pd.DataFrame:
     wall = table.loc[table["stage"] == "wall", "median_s"].iloc[0]
     table["share_of_wall"] = table["median_s"] / wall
     show(
-        "5. Stage profile of `cotm-bertini solve case3 --no-cache` (with plots), "
-        f"median of {repeats}",
+        f"5. Stage profile of `cotm-bertini solve case3 --no-cache --engine {engine}` "
+        f"(with plots), median of {repeats}",
         table,
         {c: ".3f" for c in table.columns if c.endswith("_s")} | {"share_of_wall": ".1%"},
     )
@@ -82,9 +86,10 @@ def run(repeats: int = REPEATS) -> pd.DataFrame:
         f"{bare:.3f} s"
     )
     table.attrs["interpreter_s"] = bare
-    write_csv(table, "stage_profile")
+    write_csv(table, "stage_profile" if engine == "homotopy" else f"stage_profile-{engine}")
     return table
 
 
 if __name__ == "__main__":
     run()
+    run(engine="cli")

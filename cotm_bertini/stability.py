@@ -25,7 +25,9 @@ class Tolerances:
     merge: float = 1e-8  # nonsingular endpoints closer than this (relative) are one solution
     hessian: float = 1e-9  # eigenvalues within this (relative to k L3^2) of 0: degenerate
     newton_steps: int = 3
-    snap: float = 1e-3  # an endpoint this close (units of L3) to a d = 0 artefact is that artefact
+    # An endpoint this close (units of L3) to a d = 0 artefact is that artefact. Small: a genuine
+    # equilibrium can sit 1e-4 from one (a spring compressed to 2e-4 m, seen in a random geometry).
+    snap: float = 2e-5
 
 
 def newton_refine(system: PolySystem, x: np.ndarray, steps: int) -> tuple[np.ndarray, np.ndarray]:

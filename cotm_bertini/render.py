@@ -74,14 +74,18 @@ def variable_groups(system: PolySystem, settings: Settings) -> list[list[str]]:
     return groups
 
 
+def _functions(system: PolySystem) -> list[dict[str, str]]:
+    return [
+        {"name": n, "text": polynomial_text(system.variables, e, c)}
+        for n, e, c in zip(system.names, system.exponents, system.coefficients, strict=True)
+    ]
+
+
 def render_input(
     system: PolySystem, settings: Settings, params: dict[str, float], title: str = ""
 ) -> str:
     """The Bertini classic input file text for `system` under `settings`."""
-    functions = [
-        {"name": n, "text": polynomial_text(system.variables, e, c)}
-        for n, e, c in zip(system.names, system.exponents, system.coefficients, strict=True)
-    ]
+    functions = _functions(system)
     return (
         _environment()
         .get_template("zero_dim.input.j2")
@@ -97,10 +101,7 @@ def render_input(
 
 def render_system(system: PolySystem) -> str:
     """A bare INPUT section (no CONFIG) for Bertini 2's in-process parser; complex allowed."""
-    functions = [
-        {"name": n, "text": polynomial_text(system.variables, e, c)}
-        for n, e, c in zip(system.names, system.exponents, system.coefficients, strict=True)
-    ]
+    functions = _functions(system)
     return (
         _environment()
         .get_template("system.input.j2")

@@ -12,7 +12,7 @@ import json
 import os
 import time
 from collections.abc import Callable, Iterable
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
@@ -79,15 +79,6 @@ class SweepSpec:
         if self.param2:
             rng += f"-{self.param2}-{self.start2:g}-{self.stop2:g}-{self.points2}"
         return f"sweep-{rng}-{self.key()}"
-
-
-@dataclass
-class PointResult:
-    """One solved point: its rows and how they were obtained."""
-
-    index: int
-    rows: pd.DataFrame
-    info: dict = field(default_factory=dict)
 
 
 def solve_point(

@@ -49,12 +49,12 @@ bench: $(STAMP) phcpack
 	$(BIN)/python bench/run_all.py
 
 lint: $(STAMP)
-	$(BIN)/ruff check cotm_bertini tests
-	$(BIN)/ruff format --check cotm_bertini tests
+	$(BIN)/ruff check cotm_bertini tests bench
+	$(BIN)/ruff format --check cotm_bertini tests bench
 
 format: $(STAMP)
-	$(BIN)/ruff format cotm_bertini tests
-	$(BIN)/ruff check --fix cotm_bertini tests
+	$(BIN)/ruff format cotm_bertini tests bench
+	$(BIN)/ruff check --fix cotm_bertini tests bench
 
 clean-runs:
 	find runs -mindepth 1 -maxdepth 1 ! -name README.md -exec rm -rf {} +

@@ -92,7 +92,7 @@ def median(values: list[float]) -> float:
 
 def run_bertini2(input_text: str, folder: Path, timeout: float = 900.0) -> float:
     """Write `input` into a new folder and run the bertini2 binary there; its wall seconds."""
-    from cotm_bertini.engine import child_environment, find_engine
+    from cotm_bertini.backends.engine import child_environment, find_engine
 
     eng = find_engine()
     folder.mkdir(parents=True)
@@ -121,7 +121,7 @@ def endpoints_from_finite_solutions(folder: Path, variables: tuple[str, ...]) ->
     multihomogeneous start; SecurityLevel 1, where main_data also lists the paths at infinity).
     No per-path metadata: condition numbers are left to classify's own Jacobian.
     """
-    from cotm_bertini.parse import METADATA_COLUMNS, read_solution_list
+    from cotm_bertini.backends.parse import METADATA_COLUMNS, read_solution_list
 
     pts = read_solution_list(folder / "finite_solutions")
     pts = pts.reshape(len(pts), len(variables))

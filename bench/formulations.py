@@ -36,7 +36,7 @@ def _rational(value: float) -> sp.Rational:
 
 def numeric_system(variables, names, exprs, subs: dict):
     """sympy polynomials with numbers substituted -> the package's PolySystem."""
-    from cotm_bertini.polynomial import PolySystem
+    from cotm_bertini.model.polynomial import PolySystem
 
     exps, coeffs = [], []
     for e in exprs:
@@ -48,7 +48,7 @@ def numeric_system(variables, names, exprs, subs: dict):
 
 def tan_half(params):
     """The paper's tan-half system of this case, numbers substituted."""
-    from cotm_bertini.equations import PSYM, tan_half_system
+    from cotm_bertini.model.equations import PSYM, tan_half_system
 
     variables, eqs = tan_half_system(params.zfl)
     subs = {PSYM[k]: _rational(v) for k, v in params.as_dict().items()}
@@ -94,8 +94,8 @@ def force_density(params):
 
 def solve_bertini2(system, params, title: str) -> tuple[float, pd.DataFrame]:
     """Total-degree solve by the bertini2 command (default config: MPType 2, seed 1)."""
-    from cotm_bertini.parse import read_output
-    from cotm_bertini.render import render_input
+    from cotm_bertini.backends.parse import read_output
+    from cotm_bertini.backends.render import render_input
     from cotm_bertini.settings import Settings
 
     text = render_input(system, Settings(seed=1, engine="cli"), params.as_dict(), title)
@@ -108,8 +108,8 @@ def solve_bertini2(system, params, title: str) -> tuple[float, pd.DataFrame]:
 
 def _cos_sin_residual(params, cs: np.ndarray) -> np.ndarray:
     """Relative residual of the package's cos/sin system at points (c1, s1, c2, s2, d...)."""
-    from cotm_bertini.compiled import polynomial_system
-    from cotm_bertini.geometry import normalized
+    from cotm_bertini.model.compiled import polynomial_system
+    from cotm_bertini.params import normalized
 
     system = polynomial_system(normalized(params))
     z = cs.copy()
@@ -142,8 +142,9 @@ def _near_i(x: np.ndarray) -> np.ndarray:
 
 def analyse(case: str, name: str, system, seconds: float, endpoints, params, reference) -> dict:
     """Distinct finite, spurious, artefacts and physical equilibria of one formulation's solve."""
-    from cotm_bertini.compiled import polynomial_system
-    from cotm_bertini.stability import classify, cluster_endpoints
+    from cotm_bertini.model.compiled import polynomial_system
+    from cotm_bertini.analysis.classify import classify
+    from cotm_bertini.analysis.cluster import cluster_endpoints
 
     variables = list(system.variables)
     x = endpoints[variables].to_numpy(dtype=complex)
@@ -196,7 +197,7 @@ def analyse(case: str, name: str, system, seconds: float, endpoints, params, ref
 
 def _from_grid(case: str, name: str, outcome, params, reference, groups: str) -> dict:
     """A row for the package's cos/sin system from a settings-grid measurement."""
-    from cotm_bertini.compiled import polynomial_system
+    from cotm_bertini.model.compiled import polynomial_system
 
     r, table = outcome.row, outcome.solutions
     system = polynomial_system(params)
@@ -228,7 +229,7 @@ def run(
     """Cases 2 and 3 in four formulations: printed, written to formulations.csv, returned."""
     from settings_grid import GRID, measure
 
-    from cotm_bertini.geometry import make_params
+    from cotm_bertini.params import make_params
 
     grid = dict(grid or {})
     points = {p.name: p for p in GRID}

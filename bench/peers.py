@@ -57,9 +57,9 @@ def cli_end_to_end(repeats: int = REPEATS) -> tuple[list[float], pd.DataFrame]:
 
 def bare_bertini2(params) -> tuple[float, pd.DataFrame]:
     """bertini2 on the total-degree input the package renders (default config)."""
-    from cotm_bertini.compiled import polynomial_system
-    from cotm_bertini.parse import read_output
-    from cotm_bertini.render import render_input
+    from cotm_bertini.model.compiled import polynomial_system
+    from cotm_bertini.backends.parse import read_output
+    from cotm_bertini.backends.render import render_input
     from cotm_bertini.settings import Settings
 
     text = render_input(polynomial_system(params), Settings(seed=1, engine="cli"), params.as_dict())
@@ -71,8 +71,8 @@ def bare_bertini2(params) -> tuple[float, pd.DataFrame]:
 
 def phcpack(params) -> tuple[float, pd.DataFrame, str]:
     """phc -b through the package's wrapper, timed around the call."""
-    from cotm_bertini.compiled import polynomial_system
-    from cotm_bertini.phc import solve_phc
+    from cotm_bertini.model.compiled import polynomial_system
+    from cotm_bertini.backends.phc import solve_phc
 
     system = polynomial_system(params)
     start = time.perf_counter()
@@ -87,9 +87,9 @@ def zero_dim_solver(params) -> tuple[float, pd.DataFrame, str]:
     import bertini
     from bertini import nag_algorithm as na
 
-    from cotm_bertini.compiled import polynomial_system
-    from cotm_bertini.homotopy import endpoint_row, endpoints_frame
-    from cotm_bertini.render import render_system
+    from cotm_bertini.model.compiled import polynomial_system
+    from cotm_bertini.backends.homotopy import endpoint_row, endpoints_frame
+    from cotm_bertini.backends.render import render_system
 
     bertini.recording(False)
     system = polynomial_system(params)
@@ -111,8 +111,8 @@ def zero_dim_solver(params) -> tuple[float, pd.DataFrame, str]:
 
 def parameter_homotopy(params, repeats: int = REPEATS) -> tuple[list[float], pd.DataFrame, str]:
     """homotopy.solve_target alone (generic set from the disk cache), median of `repeats`."""
-    from cotm_bertini.compiled import parametric_system
-    from cotm_bertini.homotopy import solve_target
+    from cotm_bertini.model.compiled import parametric_system
+    from cotm_bertini.backends.homotopy import solve_target
 
     ps = parametric_system(params.zfl)
     solve_target(ps, params, 1)  # warm: generic set loaded (or solved) and bertini imported
@@ -126,9 +126,9 @@ def parameter_homotopy(params, repeats: int = REPEATS) -> tuple[list[float], pd.
 
 def run(reference: dict[str, pd.DataFrame] | None = None) -> pd.DataFrame:
     """The peers table: printed, written to peers.csv, returned."""
-    from cotm_bertini.compiled import polynomial_system
-    from cotm_bertini.geometry import make_params
-    from cotm_bertini.stability import classify
+    from cotm_bertini.model.compiled import polynomial_system
+    from cotm_bertini.params import make_params
+    from cotm_bertini.analysis.classify import classify
 
     params = make_params(CASE)
     ref = reference[CASE] if reference else None

@@ -73,8 +73,8 @@ def newton_mp(params, g1_deg: float, g2_deg: float, steps: int = 40) -> dict:
 
 def reference_case(case: str) -> pd.DataFrame:
     """The physical equilibria of one case (Table 1 parameters), refined to 40 digits."""
-    from cotm_bertini.critical_points import critical_points
-    from cotm_bertini.geometry import make_params
+    from cotm_bertini.analysis.critical_points import critical_points
+    from cotm_bertini.params import make_params
 
     params = make_params(case)
     rows = []

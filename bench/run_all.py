@@ -27,7 +27,7 @@ SWEEP_POINTS = 241
 
 def sweep_time(points: int = SWEEP_POINTS) -> dict:
     """The paper's sweep (L01 0..12 m, L02 = 0, Table 1) as bench/sweep.py runs it, no plots."""
-    from cotm_bertini.geometry import TABLE1
+    from cotm_bertini.params import TABLE1
     from cotm_bertini.sweep import (
         SweepSpec,
         default_workers,

@@ -104,9 +104,9 @@ class Outcome:
 
 def _solve_once(params, settings, paths_if_unknown: int) -> tuple[dict, pd.DataFrame, pd.DataFrame]:
     """One timed solve: (measurements, solutions table, raw finite endpoints)."""
-    from cotm_bertini.parse import ParseError
+    from cotm_bertini.backends.parse import ParseError
     from cotm_bertini.pipeline import solve_in
-    from cotm_bertini.stability import classify
+    from cotm_bertini.analysis.classify import classify
 
     with tempfile.TemporaryDirectory(prefix="bench-grid-") as tmp:
         folder = Path(tmp) / "run"
@@ -143,15 +143,15 @@ def _solve_once(params, settings, paths_if_unknown: int) -> tuple[dict, pd.DataF
 
 
 def _variables(params) -> tuple[str, ...]:
-    from cotm_bertini.compiled import polynomial_system
+    from cotm_bertini.model.compiled import polynomial_system
 
     return polynomial_system(params).variables
 
 
 def _paths(params, settings) -> int:
     """Paths Bertini tracks for a CLI solve: total degree, or the multihomogeneous Bezout number."""
-    from cotm_bertini.compiled import polynomial_system
-    from cotm_bertini.render import variable_groups
+    from cotm_bertini.model.compiled import polynomial_system
+    from cotm_bertini.backends.render import variable_groups
 
     system = polynomial_system(params)
     return multihomogeneous_bezout(system, variable_groups(system, settings))
@@ -159,7 +159,7 @@ def _paths(params, settings) -> int:
 
 def measure(case: str, point: Point, reference: pd.DataFrame, repeats: int = 3) -> Outcome:
     """Solve `case` with the point's settings; repeat (median) when one solve takes < 2 s."""
-    from cotm_bertini.geometry import make_params
+    from cotm_bertini.params import make_params
     from cotm_bertini.settings import Settings
 
     params = make_params(case)
@@ -194,7 +194,7 @@ def measure(case: str, point: Point, reference: pd.DataFrame, repeats: int = 3) 
 
 def warm_up() -> pd.DataFrame:
     """First solves of the process (imports, engine start, generic sets): timed, not graded."""
-    from cotm_bertini.geometry import make_params
+    from cotm_bertini.params import make_params
     from cotm_bertini.pipeline import solve
     from cotm_bertini.settings import Settings
 

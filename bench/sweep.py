@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cotm_bertini.geometry import TABLE1, make_params
+from cotm_bertini.params import TABLE1, make_params
 from cotm_bertini.pipeline import solve_in
 from cotm_bertini.settings import Settings
 from cotm_bertini.sweep import SweepSpec, default_workers, prepare, run_points, warm_generic_sets

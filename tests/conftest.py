@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
-FIXTURES = ROOT.parent / "shared" / "fixtures" / "bertini-1.6"
+FIXTURES = Path(__file__).resolve().parent / "fixtures" / "bertini-1.6"
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 
@@ -24,21 +24,28 @@ def pytest_configure(config):
 
 @cache
 def solved(case: str, k2: float | None = None):
-    """Solve a case once per session (optionally with another k2) and keep the Solved record."""
+    """Solve a case once per session (optionally with another k2): (PointSolution, params)."""
     import tempfile
 
-    from cotm_bertini.geometry import make_params
-    from cotm_bertini.pipeline import solve_in
+    from cotm_bertini.params import make_params
+    from cotm_bertini.point import solve_point
     from cotm_bertini.settings import Settings
 
     params = make_params(case, {} if k2 is None else {"k2": k2})
     folder = Path(tempfile.mkdtemp(prefix=f"cotm-test-{case}-")) / "run"
     # The CLI route: an ab-initio total-degree solve by bertini2, independent of the homotopy.
-    return solve_in(folder, params, Settings(seed=7, engine="cli")), params
+    return solve_point(params, Settings(seed=7, engine="cli"), folder=folder), params
+
+
+def solve(params, settings=None):
+    """The solutions table of one parameter set (no cache, no files)."""
+    from cotm_bertini.point import solve_point
+    from cotm_bertini.settings import Settings
+
+    return solve_point(params, settings or Settings()).table
 
 
 @pytest.fixture(scope="session")
 def fixtures_dir() -> Path:
-    if not FIXTURES.is_dir():
-        pytest.fail(f"Bertini 1.6 fixtures not found at {FIXTURES} (shared/ must sit beside main)")
+    """Real Bertini 1.6 output of the paper's three cases (tests/fixtures/bertini-1.6)."""
     return FIXTURES

@@ -6,7 +6,7 @@ import numpy as np
 
 
 def points(p, g1, g2):
-    """P2, P3, P4, P5, P6 in frame B for angles in radians (NOTES.md labels)."""
+    """P2, P3, P4, P5, P6 in frame B for angles in radians (docs/paper.md labels)."""
     c1, s1, c2, s2 = np.cos(g1), np.sin(g1), np.cos(g2), np.sin(g2)
     p4 = np.array([p.L3 * c1, p.L3 * s1])
     rot = np.array([[c2, -s2], [s2, c2]])

@@ -14,10 +14,13 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from cotm_bertini.branches import assign_branches, find_events
-from cotm_bertini.equations import energy_hessian, parametric_system
-from cotm_bertini.geometry import TABLE1, Params
-from cotm_bertini.sweep import SweepSpec, assemble, prepare, run_points
+from cotm_bertini.continuation.events import find_events
+from cotm_bertini.continuation.matching import assign_branches
+from cotm_bertini.continuation.runner import assemble, prepare, run_points
+from cotm_bertini.continuation.spec import SweepSpec
+from cotm_bertini.model.compiled import energy_hessian, parametric_system
+from cotm_bertini.params import TABLE1, Params
+from cotm_bertini.settings import Settings
 
 PARAM = "L01"
 START, STOP, POINTS = 10.9, 11.1, 11
@@ -26,11 +29,11 @@ NEAR_DEG = 1.0  # solutions this close (each angle) to an event's angles are "ne
 
 @pytest.fixture(scope="module")
 def small(tmp_path_factory) -> tuple[pd.DataFrame, pd.DataFrame]:
-    spec = SweepSpec(base=dict(TABLE1), param=PARAM, start=START, stop=STOP, points=POINTS)
+    spec = SweepSpec.linspace(Params(**TABLE1), PARAM, START, STOP, POINTS)
     folder = prepare(spec, tmp_path_factory.mktemp("sweep"))
     run_points(spec, folder, workers=1)
     sweep = assign_branches(assemble(spec, folder), PARAM)
-    return sweep, find_events(sweep, PARAM, TABLE1, spec.seed)
+    return sweep, find_events(sweep, PARAM, TABLE1, spec.settings)
 
 
 @pytest.fixture(scope="module")
@@ -43,10 +46,11 @@ def fold(small) -> pd.Series:
 
 @pytest.fixture(scope="module")
 def solves(fold) -> dict[float, pd.DataFrame]:
-    """bertini2 ab-initio (pipeline.solve) just below and just above the fold."""
-    from cotm_bertini.pipeline import solve
+    """bertini2 ab-initio (the cli engine) just below and just above the fold."""
+    from conftest import solve
 
-    return {d: solve(Params(**{**TABLE1, PARAM: fold[PARAM] + d})) for d in (-1e-4, 1e-4)}
+    cli = Settings(engine="cli")
+    return {d: solve(Params(**{**TABLE1, PARAM: fold[PARAM] + d}), cli) for d in (-1e-4, 1e-4)}
 
 
 def _system(value: complex):
@@ -182,7 +186,7 @@ def test_stability_change_at_fold_or_confirmed(small, fold, solves):
             signs = np.sign(pair[["hess_eig1", "hess_eig2"]].to_numpy()).prod(axis=1)
             assert sorted(signs) == [-1, 1], pair
         else:
-            from cotm_bertini.pipeline import solve
+            from conftest import solve
 
             signs = []
             for d in (-1e-4, 1e-4):

@@ -24,7 +24,7 @@ def test_case1_reproduces_table2_to_printed_digits():
     to 1e-9 deg.
     """
     result, params = solved("case1")
-    s = result.solutions
+    s = result.table
     assert len(s) == 6
     real = s[s["is_real"]]
     assert len(real) == 4
@@ -55,7 +55,7 @@ def test_case1_reproduces_table2_to_printed_digits():
 def test_physical_equilibria_satisfy_balance_and_are_energy_critical(case):
     """Every physical row solves eqs (7)-(8) to 1e-10 and is a critical point of V."""
     result, params = solved(case)
-    phys = result.solutions[result.solutions["physical"]]
+    phys = result.table[result.table["physical"]]
     assert len(phys) >= 4
     for _, row in phys.iterrows():
         g1, g2 = np.radians(row["gamma1_deg"]), np.radians(row["gamma2_deg"])
@@ -85,14 +85,14 @@ def _match(table_rows, solutions):
 
 
 def test_case2_table3_physical_rows_with_corrected_ratio():
-    """With k2/k1 = 0.98909 (NOTES.md) the physical rows of Table 3 are found within 0.02 deg.
+    """With k2/k1 = 0.98909 (docs/paper.md) the physical rows of Table 3 are found within 0.02 deg.
 
     Rows 1, 2, 4, 6, 9, 11 have d1 > 0; all of them are well conditioned. (Rows 7, 8, 13, 14 are
     extra roots of the paper's elimination and match nothing; the rest have d1 < 0.)
     """
     result, _ = solved("case2", 2.81 * K_RATIO)
     rows = [TABLE3[i - 1] for i in (1, 2, 4, 6, 9, 11)]
-    for (dist, sol), printed in zip(_match(rows, result.solutions), rows, strict=True):
+    for (dist, sol), printed in zip(_match(rows, result.table), rows, strict=True):
         assert dist < 0.02, (printed, dist)
         assert sol["physical"]
         assert sol["d1"] == pytest.approx(printed[2], abs=2e-3)
@@ -111,7 +111,7 @@ def test_case3_table4_physical_rows_with_corrected_ratio():
     table[14] = (table[14][0], -69.8645, *table[14][2:])
     ids = (5, 11, 13, 14, 15, 18, 19, 21, 22, 25, 26, 28, 29)
     rows = [table[i - 1] for i in ids]
-    for (dist, sol), printed, i in zip(_match(rows, result.solutions), rows, ids, strict=True):
+    for (dist, sol), printed, i in zip(_match(rows, result.table), rows, ids, strict=True):
         assert dist < 0.02, (i, printed, dist)
         assert sol["physical"], i
         assert sol["d1"] == pytest.approx(printed[2], abs=2e-3), i
@@ -121,7 +121,7 @@ def test_case3_table4_physical_rows_with_corrected_ratio():
 def test_case3_counts_match_bertini16():
     """76 distinct finite solutions, 30 real, as Bertini 1.6 finds on the same formulation."""
     result, _ = solved("case3")
-    s = result.solutions
+    s = result.table
     assert len(s) == 76
     assert int(s["is_real"].sum()) == 30
     assert int(s["physical"].sum()) == 14
@@ -140,13 +140,14 @@ def test_homotopy_engine_equals_ab_initio(case, k2):
     the ab-initio bertini2 solve finds, complex ones included, to 1e-8 deg (1e-5 deg for the
     singular d = 0 artefacts, which an ab-initio endgame only locates to about sqrt(tolerance);
     the homotopy engine computes those in closed form)."""
-    from cotm_bertini.pipeline import solve
-    from cotm_bertini.resultant import angle_gaps
+    from conftest import solve
+
+    from cotm_bertini.analysis.resultant import angle_gaps
     from cotm_bertini.settings import Settings
 
     ref, params = solved(case, k2)
     ours = solve(params, Settings(seed=3))
-    ref = ref.solutions
+    ref = ref.table
     assert len(ours) == len(ref)
     for col in ("is_real", "physical", "stable"):
         assert ours[col].sum() == ref[col].sum(), col

@@ -67,7 +67,7 @@ def test_solve_case1_writes_run_folder(tmp_path):
     assert rec["parameters"]["L01"] == 0.0 and rec["parameters"]["L3"] == 9.0
     for key in ("bertini2", "numpy", "sympy"):
         assert rec["versions"][key] not in ("", "not installed")
-    for stage in ("derive", "render", "solve", "parse", "classify", "write", "total"):
+    for stage in ("derive", "render", "bertini", "solve", "parse", "classify", "write", "total"):
         assert rec["timings"][stage] >= 0
     assert rec["counts"]["distinct_solutions"] == 6
     assert rec["morse"]["ok"] and rec["morse"]["euler_characteristic"] == 0
@@ -218,7 +218,7 @@ def test_user_bertini1_binary(tmp_path, fixtures_dir, case):
     run = Path(r.stdout.strip())
     rec = json.loads((run / "run.json").read_text())
     assert rec["engine"]["flavour"] == "bertini1" and rec["engine"]["version"] == "1.6"
-    assert rec["output_layout"] == "bertini1"
+    assert rec["details"]["output_layout"] == "bertini1"
     expected = {"case1": (8, 6, 4), "case2": (48, 22, 10), "case3": (192, 76, 30)}[case]
     c = rec["counts"]
     assert (c["paths_tracked"], c["distinct_solutions"], c["real"]) == expected

@@ -9,9 +9,9 @@ import sympy as sp
 from physics import energy as energy_np
 from physics import energy_gradient_fd
 
-from cotm_bertini import compiled, equations
-from cotm_bertini.geometry import make_params
-from cotm_bertini.polynomial import ParametricSystem
+from cotm_bertini.model import compiled, equations
+from cotm_bertini.model.polynomial import ParametricSystem
+from cotm_bertini.params import make_params
 
 
 def test_cached_system_round_trips_and_matches_derivation():

@@ -4,13 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import solved
+from conftest import solve, solved
 
-from cotm_bertini.critical_points import compare_physical, critical_points
-from cotm_bertini.geometry import Params, make_params
-from cotm_bertini.pipeline import solve
+from cotm_bertini.analysis.critical_points import compare_physical, critical_points
+from cotm_bertini.analysis.morse import morse_check, zero_length_configurations
+from cotm_bertini.params import Params, make_params
 from cotm_bertini.settings import Settings
-from cotm_bertini.stability import morse_check, zero_length_configurations
 
 
 def random_params(seed: int) -> Params:
@@ -38,7 +37,7 @@ def random_params(seed: int) -> Params:
 def test_energy_route_finds_the_same_physical_equilibria(case):
     """Newton on grad V from a 48x48 grid finds exactly the physical rows, to 1e-6 deg."""
     result, params = solved(case)
-    cmp = compare_physical(critical_points(params), result.solutions)
+    cmp = compare_physical(critical_points(params), result.table)
     assert cmp["only_energy_route"] == 0 and cmp["only_polynomial_route"] == 0, cmp
     assert cmp["worst_deg"] < 1e-6
 
@@ -58,13 +57,13 @@ def test_energy_route_on_random_geometries(seed):
 def test_morse_count_on_the_torus(case):
     """#min - #saddle + #max = 0, zero-length cusps of springs with L0 > 0 counted as maxima."""
     result, params = solved(case)
-    check = morse_check(params, result.solutions)
+    check = morse_check(params, result.table)
     assert check["euler_characteristic"] == 0 and check["ok"], check
     if case == "case3":  # spring 2 can reach zero length: two cusps, both found as artefacts
         cusps = zero_length_configurations(params)
         assert len(cusps) == 2 and check["zero_length_maxima"] == 2
-        art = result.solutions[
-            (result.solutions["reason"] == "zero_length_spring") & result.solutions["is_real"]
+        art = result.table[
+            (result.table["reason"] == "zero_length_spring") & result.table["is_real"]
         ]
         for c in cusps:
             d = np.hypot(
@@ -77,6 +76,6 @@ def test_morse_count_on_the_torus(case):
 def test_morse_check_detects_a_missing_equilibrium():
     """Dropping one physical row breaks the count: the check can fail."""
     result, params = solved("case3")
-    s = result.solutions
+    s = result.table
     drop = s.index[s["kind"] == "saddle"][0]
     assert not morse_check(params, s.drop(index=drop))["ok"]

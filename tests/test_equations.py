@@ -5,9 +5,9 @@ Each test compares the package's sympy derivation with something built independe
 * a plain-numpy implementation of the paper's geometry and eqs. (7)-(10);
 * the paper's case-1 equations (11)-(12) as printed;
 * the tan-half form (14)-(15) with the Appendix A coefficients as printed (typos fixed);
-* the Bertini 1.6 input files in /work/shared/fixtures, written by someone else.
+* the Bertini 1.6 input files in tests/fixtures/bertini-1.6, written by someone else.
 
-Conventions (NOTES.md): in frame B, P1 = 0, P2 = [p2x, 0], P3 = [p3x, p3y]; in frame T (origin
+Conventions (docs/paper.md): in frame B, P1 = 0, P2 = [p2x, 0], P3 = [p3x, p3y]; in frame T (origin
 P4 = L3 [c1, s1], rotated by gamma2), P6 = [p6x, 0], P5 = [p5x, p5y]. Spring 1 joins P2 and P6,
 spring 2 joins P3 and P5, the rod joins P1 and P4.
 """
@@ -17,7 +17,9 @@ import pytest
 import sympy as sp
 from conftest import FIXTURES
 
-from cotm_bertini import equations, geometry
+from cotm_bertini import params as geometry
+from cotm_bertini.model import equations
+from cotm_bertini.model.compiled import polynomial_system
 
 ZFL_PATTERNS = [(True, True), (False, True), (True, False), (False, False)]
 GEOMETRY_NAMES = ("L3", "k1", "k2", "p2x", "p3x", "p3y", "p6x", "p5x", "p5y")
@@ -165,7 +167,7 @@ def test_derive_matches_independent_numpy_equations(zfl, geometry_kind):
     x = pts[:, cols]
     values = [getattr(p, n) for n in geometry.PARAM_NAMES]
     derived = fn(*x.T, *values)
-    poly = equations.polynomial_system(p)
+    poly = polynomial_system(p)
     assert poly.variables == sym.variables and poly.names == sym.names
     numeric = poly.evaluate(x)
 
@@ -259,7 +261,7 @@ def test_appendix_a_tan_half_coefficients_and_b9_typo():
 
     def quadratic_form(coef):
         # Eqs. (14)/(15): (C1 x2^2 + C2 x2 + C3) x1^2 + (C4 ..) x1 + (C7 ..), with the
-        # "A1 x1^2" misprint of (14) read as "A1 x2^2" (NOTES.md).
+        # "A1 x1^2" misprint of (14) read as "A1 x2^2" (docs/paper.md).
         return sp.Poly(
             sum(
                 (coef[3 * r + 1] * x2**2 + coef[3 * r + 2] * x2 + coef[3 * r + 3]) * x1 ** (2 - r)
@@ -342,7 +344,7 @@ def _parse_bertini_input(path):
 def test_polynomial_system_matches_bertini_fixture_input(case):
     """Each of our numeric functions is a constant multiple of one function of the fixture input."""
     variables, exprs = _parse_bertini_input(FIXTURES / case / "input")
-    poly = equations.polynomial_system(geometry.make_params(case))
+    poly = polynomial_system(geometry.make_params(case))
     assert sorted(variables) == sorted(poly.variables)
     assert len(exprs) == len(poly.names)
 

@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from cotm_bertini.geometry import TABLE1, ParameterError, make_params, parse_assignment
+from cotm_bertini.params import TABLE1, ParameterError, make_params, parse_assignment
 
 
 def test_presets_only_set_free_lengths():

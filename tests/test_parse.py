@@ -7,13 +7,14 @@ import shutil
 import numpy as np
 import pytest
 
-from cotm_bertini.engine import find_engine
-from cotm_bertini.geometry import make_params
-from cotm_bertini.parse import ParseError, read_output, read_solution_list
-from cotm_bertini.solver import run_bertini
-from cotm_bertini.stability import classify
+from cotm_bertini.analysis.classify import classify
+from cotm_bertini.backends.bertini_cli import run_bertini
+from cotm_bertini.backends.engine import find_engine
+from cotm_bertini.backends.parse import ParseError, read_output, read_solution_list
+from cotm_bertini.params import make_params
 
-# Bertini 1.6 stdout summaries (fixtures/README.md): finite endpoints and distinct solutions.
+# Bertini 1.6 stdout summaries (tests/fixtures/bertini-1.6/README.md): finite endpoints,
+# distinct solutions, real ones.
 EXPECTED = {"case1": (6, 6, 4), "case2": (24, 22, 10), "case3": (84, 76, 30)}
 
 
@@ -24,15 +25,15 @@ def test_bertini16_fixtures(fixtures_dir, case):
     endpoints, distinct, real = EXPECTED[case]
     assert out.layout == "bertini1"
     assert len(out.endpoints) == endpoints == out.finite_solutions_count
-    assert out.endpoints["path_number"].is_unique
+    assert len(set(out.endpoints.path_number)) == len(out.endpoints)
     # Every endpoint of finite_solutions is in the table (Bertini 1 prints one of the paths of a
     # multiple root in main_data; the others agree with it to the tracking accuracy).
     finite = read_solution_list(fixtures_dir / case / "finite_solutions")
-    pts = out.points()
+    pts = out.endpoints.points
     for p in finite:
         assert np.abs(pts - p).max(axis=1).min() < 1e-9
     params = make_params(case)
-    table = classify(params, out.endpoints, out.variables)
+    table = classify(params, out.endpoints)
     assert len(table) == distinct
     assert int(table["is_real"].sum()) == real
     assert table["multiplicity"].sum() == endpoints
@@ -46,11 +47,12 @@ def test_fresh_bertini2_run_has_same_table_shape(fixtures_dir, tmp_path):
     )
     b2 = read_output(run.folder)
     assert b2.layout == "bertini2"
-    assert list(b2.endpoints.columns) == list(b1.endpoints.columns)
-    assert dict(b2.endpoints.dtypes) == dict(b1.endpoints.dtypes)
+    f1, f2 = b1.endpoints.frame(), b2.endpoints.frame()
+    assert list(f2.columns) == list(f1.columns)
+    assert dict(f2.dtypes) == dict(f1.dtypes)
     params = make_params("case1")
-    t1 = classify(params, b1.endpoints, b1.variables)
-    t2 = classify(params, b2.endpoints, b2.variables)
+    t1 = classify(params, b1.endpoints)
+    t2 = classify(params, b2.endpoints)
     assert list(t1.columns) == list(t2.columns)
     assert len(t1) == len(t2) == 6
     for a, b in zip(t1.itertuples(), t2.itertuples(), strict=True):
@@ -80,7 +82,8 @@ def test_malformed_files_raise(fixtures_dir, tmp_path):
 def test_bertini2_output_variants_parse_to_the_same_solutions(settings):
     """main_data with endpoints at infinity (SecurityLevel 1) or one homogenizing variable per
     variable group (multihomogeneous start) gives the same case-2 solutions as the default."""
-    from cotm_bertini.pipeline import solve
+    from conftest import solve
+
     from cotm_bertini.settings import Settings
 
     params = make_params("case2")

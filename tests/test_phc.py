@@ -1,8 +1,8 @@
 """PHCpack (`phc -b`) as a peer of Bertini: the same solutions for the three cases of Table 1.
 
 The PHCpack tests fail, not skip, when `phc` is missing: `apt-get install phcpack` (the Makefile
-installs it before the tests). Bertini's side is the pipeline route (`solve_in`, which
-`pipeline.solve` wraps), solved once per session by `conftest.solved`.
+installs it before the tests). Bertini's side is the cli engine (`solve_point` with
+engine="cli"), solved once per session by `conftest.solved`.
 """
 
 from __future__ import annotations
@@ -16,11 +16,11 @@ import pandas as pd
 import pytest
 from conftest import solved
 
-from cotm_bertini import phc
-from cotm_bertini.equations import polynomial_system
-from cotm_bertini.geometry import make_params
-from cotm_bertini.parse import METADATA_COLUMNS
-from cotm_bertini.stability import classify
+from cotm_bertini.analysis.classify import classify
+from cotm_bertini.backends import phc
+from cotm_bertini.backends.endpoints import METADATA_COLUMNS
+from cotm_bertini.model.compiled import polynomial_system
+from cotm_bertini.params import make_params
 
 # phc's random start system depends on the seed. Seed 1 is fixed for reproducibility; with some
 # other seeds phc -b leaves a double root of case 3 accurate to only ~1e-5, which `classify` may
@@ -52,7 +52,7 @@ def _phc(case: str, seed: int = PHC_SEED):
     params = make_params(case)
     system = polynomial_system(params)
     result = phc.solve_phc(system, timeout=300, seed=seed)
-    table = classify(params, result.endpoints, system.variables)
+    table = classify(params, result.endpoints)
     return params, system, result, table
 
 
@@ -86,7 +86,7 @@ def test_phc_finds_the_solutions_bertini_finds(case):
     and the same classification (real, reason, physical, stable, kind) on matched rows."""
     _require_phc()
     _, _, result, ours = _phc(case)
-    theirs = solved(case)[0].solutions
+    theirs = solved(case)[0].table
     n_paths, n_end, n_sol, n_real = EXPECTED[case]
     assert len(theirs) == n_sol and int(theirs["is_real"].sum()) == n_real  # Bertini's side
     assert len(ours) == len(theirs), (len(ours), len(theirs))
@@ -116,9 +116,9 @@ def test_phc_paths_endpoints_and_variable_order(case):
     _require_phc()
     _, system, result, _ = _phc(case)
     n_paths, n_end, _, _ = EXPECTED[case]
-    e = result.endpoints
+    e = result.endpoints.frame()
     assert result.root_count == n_paths, (result.root_count, result.root_counts)
-    assert len(e) == n_end == len(solved(case)[0].output.endpoints)
+    assert len(e) == n_end == len(solved(case)[0].endpoints)
     assert result.phc_solution_count == len(e)  # our label filter keeps what phc keeps
     assert list(e.columns) == list(METADATA_COLUMNS) + list(system.variables)
     assert set(result.phc_variables) == set(system.variables)
@@ -147,7 +147,8 @@ def test_phc_root_counts_per_case():
     assert (r3.root_counts["mixed_volume"], r3.root_counts["stable_mixed_volume"]) == (144, 160)
     assert r3.root_counts["total_degree"] == 192
     # The six complex roots with d1 = d2 = 0 only the stable-mixed-volume paths reach.
-    zero = (r3.endpoints["d1"].abs() < 1e-30) & (r3.endpoints["d2"].abs() < 1e-30)
+    e3 = r3.endpoints.frame()
+    zero = (e3["d1"].abs() < 1e-30) & (e3["d2"].abs() < 1e-30)
     assert int(zero.sum()) == 6
     assert not any("infinity" in label for label in r3.labels)
 
@@ -161,13 +162,13 @@ def test_case3_every_seed_reaches_every_regular_root(seed):
     which is why the comparison above uses seed 1, where every endpoint is good to 1e-10."""
     _require_phc()
     _, system, result, _ = _phc("case3", seed)
-    theirs = solved("case3")[0].solutions
+    theirs = solved("case3")[0].table
     names = list(system.variables)
     roots = (
         theirs[[f"{v}_re" for v in names]].to_numpy()
         + 1j * theirs[[f"{v}_im" for v in names]].to_numpy()
     )
-    ends = result.endpoints[names].to_numpy(dtype=complex)
+    ends = result.endpoints.frame()[names].to_numpy(dtype=complex)
     assert len(ends) == 84
     rel = (np.abs(ends[:, None, :] - roots[None]) / (1 + np.abs(roots[None]))).max(axis=2)
     regular = ~theirs["singular"].to_numpy()
@@ -181,7 +182,7 @@ def test_phc_is_reproducible_with_a_seed():
     system = polynomial_system(make_params("case2"))
     a = phc.solve_phc(system, seed=5)
     b = phc.solve_phc(system, seed=5)
-    pd.testing.assert_frame_equal(a.endpoints, b.endpoints)
+    pd.testing.assert_frame_equal(a.endpoints.frame(), b.endpoints.frame())
     assert a.seed == b.seed == 5
     with pytest.raises(ValueError, match="positive"):
         phc.solve_phc(system, seed=0)
@@ -204,6 +205,9 @@ def _read_back(text: str, variables: tuple[str, ...]) -> list[dict[tuple[int, ..
     polys = []
     for line in lines[1:]:
         assert line.endswith(";")
+        line = line.strip()
+        # The first term carries its sign without a space ("-2.0E+00*x ..." or "2.0E+00*x ...").
+        line = ("+ " + line) if line[0] not in "+-" else (line[0] + " " + line[1:].lstrip())
         terms: dict[tuple[int, ...], float] = {}
         for sign, coef, mono in re.findall(r"([+-]) (\S+?E[+-]\d+)((?:\*\w+(?:\^\d+)?)*)", line):
             exps = [0] * len(variables)
@@ -289,7 +293,7 @@ def test_parse_keeps_finite_ends_in_system_order():
         "at infinity",
         "complex clustered : 1",
     ]
-    e = phc.endpoints_frame(records, ("x", "y"), order)
+    e = phc.endpoints_from_records(records, ("x", "y"), order).frame()
     assert list(e.columns) == list(METADATA_COLUMNS) + ["x", "y"]
     assert e["path_number"].tolist() == [1, 3, 5]
     assert e["x"].tolist() == [1 - 0.5j, 3 + 0j, 1 - 0.5j]

@@ -15,7 +15,7 @@ PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 @pytest.fixture(scope="module")
 def case1():
     result, params = solved("case1")
-    return params, result.solutions
+    return params, result.table
 
 
 def _lines(fig) -> dict[str, np.ndarray]:
@@ -39,7 +39,7 @@ def _expected_points(params, g1_deg: float, g2_deg: float) -> dict[int, np.ndarr
 
 
 def test_plot_run_writes_png_and_svg(case1, tmp_path):
-    from cotm_bertini.plot import plot_run
+    from cotm_bertini.plot.run import plot_run
 
     params, sols = case1
     paths = plot_run(params, sols, tmp_path)
@@ -62,7 +62,7 @@ def test_plot_run_writes_png_and_svg(case1, tmp_path):
 
 
 def test_one_panel_per_physical_row(case1):
-    from cotm_bertini.plot import configurations_figure
+    from cotm_bertini.plot.configurations import configurations_figure
 
     params, sols = case1
     phys = sols[sols["physical"]]
@@ -88,7 +88,7 @@ def test_one_panel_per_physical_row(case1):
 
 def test_drawn_points_equal_geometry(case1):
     """Bodies, rod and springs of every panel join the points computed from the angles."""
-    from cotm_bertini.plot import configurations_figure
+    from cotm_bertini.plot.configurations import configurations_figure
 
     params, sols = case1
     lines = _lines(configurations_figure(params, sols))
@@ -109,8 +109,8 @@ def test_drawn_points_equal_geometry(case1):
 
 
 def test_energy_map_marks_equilibria_at_their_critical_points(case1):
-    from cotm_bertini.equations import energy
-    from cotm_bertini.plot import energy_map_figure
+    from cotm_bertini.model.compiled import energy
+    from cotm_bertini.plot.energy_map import energy_map_figure
 
     params, sols = case1
     fig = energy_map_figure(params, sols)
@@ -132,7 +132,7 @@ def test_energy_map_marks_equilibria_at_their_critical_points(case1):
 
 
 def test_no_physical_solution_gives_a_figure_that_says_so(case1, tmp_path):
-    from cotm_bertini.plot import configurations_figure, plot_configurations
+    from cotm_bertini.plot.configurations import configurations_figure, plot_configurations
 
     params, sols = case1
     none = sols.assign(physical=False, stable=False)
@@ -146,7 +146,8 @@ def test_no_physical_solution_gives_a_figure_that_says_so(case1, tmp_path):
 
 def test_the_rest_of_the_package_does_not_import_matplotlib():
     code = (
-        "import sys, cotm_bertini.pipeline, cotm_bertini.cli, cotm_bertini.stability; "
+        "import sys, cotm_bertini.point, cotm_bertini.cli.commands, cotm_bertini.api.solutions, "
+        "cotm_bertini.api.sweeps, cotm_bertini.continuation.events, cotm_bertini.analysis.verify; "
         "print('matplotlib' in sys.modules)"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)

@@ -16,12 +16,13 @@ L01_VALUES = np.linspace(0.5, 12.0, 11)
 
 
 def _solve(points: list[dict[str, float]]) -> pd.DataFrame:
-    from cotm_bertini.geometry import TABLE1
-    from cotm_bertini.sweep import solve_point
+    from cotm_bertini.continuation.runner import point_table
+    from cotm_bertini.params import Params
+    from cotm_bertini.settings import Settings
 
     frames = []
     for k, values in enumerate(points):
-        table = solve_point(dict(TABLE1), values, seed=1)
+        table = point_table(Params(**values), Settings(seed=1), values)
         table["point"] = k
         frames.append(table)
     return pd.concat(frames, ignore_index=True)
@@ -124,7 +125,7 @@ def test_data_has_what_the_figures_need(sweep1d):
 
 
 def test_bifurcation_writes_png_and_svg(sweep1d, tmp_path):
-    from cotm_bertini.plot import plot_bifurcation
+    from cotm_bertini.plot.bifurcation import plot_bifurcation
 
     stem = tmp_path / "bifurcation"
     events = stand_in_events(sweep1d, "L01")
@@ -135,7 +136,7 @@ def test_bifurcation_writes_png_and_svg(sweep1d, tmp_path):
 @pytest.mark.parametrize("with_branches", [True, False])
 def test_plotted_points_are_the_rows(sweep1d, with_branches):
     """Stable markers = stable rows, unstable markers = the other physical rows, in both panels."""
-    from cotm_bertini.plot import bifurcation_figure
+    from cotm_bertini.plot.bifurcation import bifurcation_figure
 
     data = sweep1d if with_branches else sweep1d.drop(columns="branch")
     fig = bifurcation_figure(data, "L01")
@@ -172,7 +173,7 @@ def _all_pieces(fig) -> list[np.ndarray]:
 
 def test_no_line_jumps_across_the_plot(sweep1d):
     """No drawn segment spans more than 180 deg; lines cut at 0/360 reach the edge instead."""
-    from cotm_bertini.plot import bifurcation_figure
+    from cotm_bertini.plot.bifurcation import bifurcation_figure
 
     fig = bifurcation_figure(sweep1d, "L01", show_all=True)
     pieces = _all_pieces(fig)
@@ -189,7 +190,7 @@ def test_no_line_jumps_across_the_plot(sweep1d):
 
 def test_wrap_and_gap_on_a_hand_made_branch():
     """350 -> 10 deg is cut at 360/0; a missing parameter value or a 170 deg step is a gap."""
-    from cotm_bertini.plot import bifurcation_figure
+    from cotm_bertini.plot.bifurcation import bifurcation_figure
 
     # Branch 0 at x = 0..5 and 7 (wraps at 1-2, turns unstable at 3-4, steps 170 deg at 4-5,
     # skips x = 6); branch 1 is a single row at x = 6.
@@ -225,7 +226,7 @@ def test_wrap_and_gap_on_a_hand_made_branch():
 
 
 def test_show_all_adds_the_nonphysical_real_rows(sweep1d):
-    from cotm_bertini.plot import bifurcation_figure
+    from cotm_bertini.plot.bifurcation import bifurcation_figure
 
     default = _panels(bifurcation_figure(sweep1d, "L01"))
     every = _panels(bifurcation_figure(sweep1d, "L01", show_all=True))
@@ -247,7 +248,7 @@ def test_show_all_adds_the_nonphysical_real_rows(sweep1d):
 
 
 def test_events_are_marked_with_a_legend(sweep1d):
-    from cotm_bertini.plot import EVENT_STYLE, bifurcation_figure
+    from cotm_bertini.plot.bifurcation import EVENT_STYLE, bifurcation_figure
 
     events = pd.DataFrame(
         [
@@ -275,7 +276,7 @@ def test_events_are_marked_with_a_legend(sweep1d):
 
 
 def test_count_map_equals_the_per_point_counts(sweep2d, tmp_path):
-    from cotm_bertini.plot import plot_sweep_counts, sweep_counts_figure
+    from cotm_bertini.plot.counts import plot_sweep_counts, sweep_counts_figure
 
     per_point = sweep2d.groupby("point").agg(
         L01=("L01", "first"),

@@ -7,9 +7,9 @@ import re
 import numpy as np
 import sympy as sp
 
-from cotm_bertini.equations import polynomial_system
-from cotm_bertini.geometry import make_params
-from cotm_bertini.render import render_input
+from cotm_bertini.backends.render import render_input
+from cotm_bertini.model.compiled import polynomial_system
+from cotm_bertini.params import make_params
 from cotm_bertini.settings import Settings
 
 
@@ -48,7 +48,9 @@ def test_multihomogeneous_groups():
     """The multihomogeneous option groups {c1,s1}, {c2,s2} and each d alone."""
     params = make_params("case3")
     text = render_input(
-        polynomial_system(params), Settings(variable_groups="multihomogeneous"), params.as_dict()
+        polynomial_system(params),
+        Settings(engine="cli", variable_groups="multihomogeneous"),
+        params.as_dict(),
     )
     for g in ("c1, s1", "c2, s2", "d1", "d2"):
         assert f"variable_group {g};" in text

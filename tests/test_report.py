@@ -4,11 +4,11 @@ from __future__ import annotations
 
 from conftest import solved
 
-from cotm_bertini.geometry import make_params
-from cotm_bertini.paper import K_RATIO, TABLES
-from cotm_bertini.parse import read_output
-from cotm_bertini.report import Scenario, build_report, match_table
-from cotm_bertini.stability import classify
+from cotm_bertini.analysis.classify import classify
+from cotm_bertini.backends.parse import read_output
+from cotm_bertini.paper.report import Scenario, build_report, match_table
+from cotm_bertini.paper.tables import K_RATIO, TABLES
+from cotm_bertini.params import make_params
 
 
 def _fixture_scenario(fixtures_dir) -> Scenario:
@@ -17,7 +17,7 @@ def _fixture_scenario(fixtures_dir) -> Scenario:
         p = make_params(case)
         out = read_output(fixtures_dir / case)
         params[case] = p
-        tables[case] = classify(p, out.endpoints, out.variables)
+        tables[case] = classify(p, out.endpoints)
         paths[case] = {"case1": 8, "case2": 48, "case3": 192}[case]
     return Scenario("Bertini 1.6 fixtures, Table 1", params, tables, paths)
 
@@ -50,7 +50,7 @@ def test_report_from_fixtures(fixtures_dir):
 def test_table3_elimination_artefacts_with_corrected_ratio():
     """With k2/k1 = 0.98909, Table 3 rows 7, 8, 13, 14 are extra roots of the elimination."""
     result, params = solved("case2", 2.81 * K_RATIO)
-    m = match_table(TABLES[1], params, result.solutions).set_index("row")
+    m = match_table(TABLES[1], params, result.table).set_index("row")
     assert [r for r in m.index if m.loc[r, "category"] == "elimination artefact"] == [7, 8, 13, 14]
     assert set(m.loc[[1, 2, 4, 6, 9, 11], "category"]) == {"physical equilibrium"}
     assert set(m.loc[[3, 5, 10, 12], "category"]) == {"negative d"}

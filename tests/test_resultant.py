@@ -2,7 +2,7 @@
 
 Known answers come from the paper (Tables 2 and 3), from Bertini on the cos/sin formulation, and
 from closed forms derived below from the geometry for the small factors of the case-2 resultant.
-Tables 2-3 use the parameters of Table 1; Table 3 needs k2/k1 = 0.98909 (NOTES.md).
+Tables 2-3 use the parameters of Table 1; Table 3 needs k2/k1 = 0.98909 (docs/paper.md).
 """
 
 from __future__ import annotations
@@ -16,8 +16,8 @@ import sympy as sp
 from conftest import solved
 from paper_tables import K_RATIO, TABLE2, TABLE2_COMPLEX, TABLE3
 
-from cotm_bertini import resultant as rs
-from cotm_bertini.geometry import make_params
+from cotm_bertini.analysis import resultant as rs
+from cotm_bertini.params import make_params
 
 X1, X2 = rs.X1, rs.X2
 
@@ -102,7 +102,7 @@ def test_case1_roots_match_table2(case1):
 
 def test_case1_roots_match_bertini(case1):
     """The resultant's 6 roots and Bertini's 6 solutions agree to 1e-8 deg, none missing."""
-    cmp = rs.compare(case1.roots, solved("case1")[0].solutions)
+    cmp = rs.compare(case1.roots, solved("case1")[0].table)
     assert cmp.matched == 6
     assert (cmp.only_resultant, cmp.only_solutions, cmp.at_infinity) == (0, 0, 0)
     assert cmp.max_angle_deg < 1e-8
@@ -161,7 +161,7 @@ def test_case2_degree_72_and_its_factorisation(case2):
 
 def test_case2_genuine_roots_are_bertinis_solutions(case2):
     """The genuine factor gives Bertini's 20 regular solutions, the d1 = 0 one its 2 artefacts."""
-    sols = solved("case2")[0].solutions
+    sols = solved("case2")[0].table
     artefact = sols["reason"] == "zero_length_spring"
     assert int(artefact.sum()) == 2
     regular = case2.roots[case2.roots["factor"] == rs.GENUINE]
@@ -212,7 +212,7 @@ def test_case2_table3_rows_with_corrected_ratio():
         assert dist[k] < 0.02, (i, dist[k])
         assert frame["d1"].iloc[k] == pytest.approx(d1, abs=2e-3), i
 
-    cmp = rs.compare(result.roots, solved("case2", 2.81 * K_RATIO)[0].solutions)
+    cmp = rs.compare(result.roots, solved("case2", 2.81 * K_RATIO)[0].table)
     assert (cmp.matched, cmp.only_resultant, cmp.only_solutions) == (22, 0, 0)
 
 

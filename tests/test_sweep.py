@@ -12,11 +12,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from conftest import solve
 
-from cotm_bertini.geometry import TABLE1, make_params
-from cotm_bertini.pipeline import solve
+from cotm_bertini.continuation.runner import assemble, prepare, run_points
+from cotm_bertini.continuation.spec import SweepSpec
+from cotm_bertini.params import TABLE1, Params, make_params
 from cotm_bertini.settings import Settings
-from cotm_bertini.sweep import SweepSpec, assemble, prepare, run_points
 
 
 def _physical(table: pd.DataFrame) -> np.ndarray:
@@ -37,7 +38,7 @@ def _same_points(a: np.ndarray, b: np.ndarray, tol: float = 1e-6) -> bool:
 @pytest.fixture(scope="module")
 def sweep21(tmp_path_factory):
     """The paper's sweep at 21 points (L01 from 0 to 12 m, L02 = 0, Table 1)."""
-    spec = SweepSpec(dict(TABLE1), "L01", 0.0, 12.0, 21)
+    spec = SweepSpec.linspace(Params(**TABLE1), "L01", 0.0, 12.0, 21)
     folder = prepare(spec, tmp_path_factory.mktemp("sweep"))
     stats = run_points(spec, folder, workers=2)
     return spec, folder, assemble(spec, folder), stats
@@ -61,7 +62,7 @@ def test_dask_cluster_gives_the_same_rows(sweep21, tmp_path):
 
     spec0, folder0, _, _ = sweep21
     # The first 6 points of the local sweep (L01 = 0, 0.6, ..., 3), solved afresh on the cluster.
-    sub = SweepSpec(dict(TABLE1), "L01", 0.0, 3.0, 6)
+    sub = SweepSpec.linspace(Params(**TABLE1), "L01", 0.0, 3.0, 6)
     folder_sub = prepare(sub, tmp_path / "sub")
     with LocalCluster(
         n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None

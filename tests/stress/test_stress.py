@@ -17,11 +17,11 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
+from conftest import solve  # noqa: E402
 from physics import mp_refine  # noqa: E402
 
-from cotm_bertini.critical_points import critical_points  # noqa: E402
-from cotm_bertini.geometry import TABLE1, Params, make_params  # noqa: E402
-from cotm_bertini.pipeline import solve  # noqa: E402
+from cotm_bertini.analysis.critical_points import critical_points  # noqa: E402
+from cotm_bertini.params import TABLE1, Params, make_params  # noqa: E402
 from cotm_bertini.settings import Settings  # noqa: E402
 
 FULL = os.environ.get("COTM_STRESS") == "full"
@@ -114,7 +114,7 @@ def test_scaled_geometry_gives_the_same_angles(factor):
     move, and their kinds and stability stay."""
     base = make_params("case3")
     lengths = ("L3", "p2x", "p3x", "p3y", "p6x", "p5x", "p5y", "L01", "L02")
-    scaled = base.with_values(**{n: getattr(base, n) * factor for n in lengths})
+    scaled = base.replace(**{n: getattr(base, n) * factor for n in lengths})
     a, b = solve(base), solve(scaled)
     pa, pb = a[a["physical"]], b[b["physical"]]
     assert len(pa) == len(pb)

@@ -1,0 +1,1 @@
+"""Analysis: endpoints into classified solutions (real, physical, stable), mechanics, checks."""

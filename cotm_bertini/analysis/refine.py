@@ -1,0 +1,49 @@
+"""Newton refinement of endpoints, and snapping onto the closed-form d = 0 roots."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..model.artefacts import zero_length_points
+from ..model.polynomial import PolySystem
+from ..params import Params
+
+
+def newton_refine(system: PolySystem, x: np.ndarray, steps: int) -> tuple[np.ndarray, np.ndarray]:
+    """A few complex Newton steps, each kept only where it lowers the residual."""
+    x = np.array(x, dtype=complex)
+    scale = system.scale()
+    res = np.abs(system.evaluate(x) / scale).max(axis=1)
+    for _ in range(steps):
+        f = system.evaluate(x)
+        jac = system.jacobian(x)
+        step = np.zeros_like(x)
+        ok = np.isfinite(jac).all(axis=(1, 2)) & (np.linalg.cond(jac) < 1e14)
+        if ok.any():
+            step[ok] = np.linalg.solve(jac[ok], f[ok][..., None])[..., 0]
+        trial = x - step
+        new = np.abs(system.evaluate(trial) / scale).max(axis=1)
+        better = ok & (new < res)
+        x[better] = trial[better]
+        res[better] = new[better]
+    return x, res
+
+
+def snap_zero_length(
+    params: Params, variables: tuple[str, ...], x: np.ndarray, radius: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Put endpoints within `radius` (normalised units) of a d = 0 artefact exactly there.
+
+    An endgame only reaches such a double root to about the square root of its tolerance, and
+    its two paths may end apart; the closed form knows the point exactly.
+    """
+    snapped = np.zeros(len(x), dtype=bool)
+    exact = zero_length_points(params.normalized(), variables)
+    if not len(exact) or not len(x):
+        return x, snapped
+    x = x.copy()
+    for point in exact:
+        near = np.abs(x - point).max(axis=1) < radius
+        x[near] = point
+        snapped |= near
+    return x, snapped

@@ -1,0 +1,1 @@
+"""The public API: solve a parameter set, sweep parameters; results as objects."""

@@ -1,0 +1,228 @@
+"""`solve` and its result, `Solutions`: every equilibrium of one parameter set."""
+
+from __future__ import annotations
+
+import shutil
+import tempfile
+import time
+import weakref
+from dataclasses import asdict, fields
+from pathlib import Path
+
+from ..errors import CotmError, ParameterError
+from ..fs import timestamp, write_json
+from ..io import cache
+from ..io.runfolder import (
+    RUN_JSON,
+    copy_run,
+    figure_files,
+    read_record,
+    read_solutions,
+    solve_record,
+    write_solution_files,
+)
+from ..params import Params
+from ..settings import Settings, Tolerances
+
+
+class Solutions:
+    """The classified solutions of one parameter set, as a table and counts, savable as a run.
+
+    `table` has exactly the solutions.csv columns (docs/columns.md); `physical`, `stable`,
+    `real` and `nonsingular` are its filtered views. `counts`, `morse`, `status` and `warnings`
+    say what was found and whether a completeness check failed. `save(folder)` writes the run
+    folder the command line writes.
+    """
+
+    def __init__(self, params: Params, settings: Settings, record: dict, folder: Path, table=None):
+        self.params = params
+        self.settings = settings
+        self.record = record
+        self.folder = Path(folder)  # holds solutions.csv, run.json, input and solver files
+        self._table = table
+
+    def __repr__(self) -> str:
+        c = self.counts
+        return (
+            f"<Solutions {c['distinct_solutions']} finite, {c['real']} real, "
+            f"{c['physical']} physical, {c['stable']} stable; status {self.status}>"
+        )
+
+    @property
+    def table(self):
+        """Every distinct finite solution (pandas DataFrame, the solutions.csv columns)."""
+        if self._table is None:
+            self._table = read_solutions(self.folder)
+        return self._table
+
+    @property
+    def real(self):
+        """The real solutions (physical or not)."""
+        return self.table[self.table["is_real"].astype(bool)]
+
+    @property
+    def nonsingular(self):
+        """The solutions that are not singular."""
+        return self.table[~self.table["singular"].astype(bool)]
+
+    @property
+    def physical(self):
+        """The physical equilibria: real, both spring lengths > 0."""
+        return self.table[self.table["physical"].astype(bool)]
+
+    @property
+    def stable(self):
+        """The stable equilibria: strict local minima of the energy."""
+        return self.table[self.table["stable"].astype(bool)]
+
+    @property
+    def counts(self) -> dict:
+        """Paths tracked, finite endpoints, distinct, real, physical, stable solutions, ..."""
+        return self.record["counts"]
+
+    @property
+    def morse(self) -> dict:
+        """The Morse count on the torus (ok, min, saddle, max, zero_length_maxima, ...)."""
+        return self.record["morse"]
+
+    @property
+    def status(self) -> str:
+        """'ok', or 'incomplete' when a completeness check failed (see `warnings`)."""
+        return self.record["status"]
+
+    @property
+    def warnings(self) -> list[str]:
+        """Why equilibria may be missing, if they may."""
+        return list(self.record.get("warnings", []))
+
+    @property
+    def summary(self) -> str:
+        """The console report: counts and the real solutions."""
+        return self.record["summary"]
+
+    @property
+    def cache_hit(self) -> bool:
+        """Whether this result was read from the cache rather than solved now."""
+        return bool(self.record.get("cache", {}).get("hit"))
+
+    def save(
+        self, folder: str | Path, plots: bool = True, command: list[str] | None = None
+    ) -> Path:
+        """Write the run folder: solutions.csv, run.json, columns.md, input, solver files and,
+        with `plots`, configurations.* and energy_map.*; built under a hidden name, then renamed.
+        """
+        update = {"created": timestamp(), "command": command, "cache": self.record.get("cache")}
+        dest = copy_run(self.folder, Path(folder), update, with_figures=plots)
+        if plots and not figure_files(dest):
+            drawn = _draw(self.params, self.table, dest)
+            key = self.record.get("cache_key")
+            if key and self.folder == cache.entry(key):
+                cache.add_files(key, drawn)  # the next identical request finds them
+        names = [p.name for p in figure_files(dest)] if plots else []
+        _update_record(dest, {"figures": names})
+        return dest
+
+
+def _draw(params: Params, table, folder: Path) -> list[Path]:
+    from ..plot.run import plot_run  # matplotlib only when pictures are asked for
+
+    start = time.perf_counter()
+    paths = plot_run(params, table, folder)
+    _update_record(folder, {"plot_seconds": time.perf_counter() - start})
+    return paths
+
+
+def _update_record(folder: Path, fields: dict) -> None:
+    write_json(folder / RUN_JSON, read_record(folder) | fields)
+
+
+def solve(
+    params: Params,
+    settings: Settings | None = None,
+    *,
+    cache: bool = True,
+    tolerances=None,
+    label: str = "",
+    **options,
+) -> Solutions:
+    """Every equilibrium of `params`: all finite solutions, classified real, physical, stable.
+
+    Options are Settings fields (seed, engine, mptype, final_tol, timeout, threads, ...), each
+    honoured or refused with ParameterError. An identical earlier request is answered from the
+    content-hash cache (`cache=False` solves again). A solver failure raises SolverError; its
+    `folder` attribute holds what the solver left (input, output, failed attempts, run.json).
+    """
+    from ..io import cache as solve_cache
+
+    settings = (settings or Settings()).replace(**options)
+    tol = _tolerances(tolerances)
+    key = solve_cache.request_key(params.as_dict(), settings.result_key(), tol)
+    if cache:
+        hit = solve_cache.lookup(key)
+        if hit is not None:
+            record = read_record(hit)
+            record["cache"] = {"hit": True, "key": key, "solved": record.get("solved")}
+            return Solutions(params, settings, record, hit)
+    start = time.perf_counter()
+    work = solve_cache.staging_folder() if cache else Path(tempfile.mkdtemp(prefix="cotm-"))
+    point = _solve_in(work, params, settings, tol, label or "custom")
+    record = solve_record(point, tol, label or "custom", key if cache else None)
+    record["cache"] = {"hit": False, "key": key if cache else None}
+    t0 = time.perf_counter()
+    write_solution_files(work, point)
+    record["timings"].update(write=time.perf_counter() - t0, total=time.perf_counter() - start)
+    write_json(work / RUN_JSON, record)
+    if cache:
+        folder = solve_cache.commit(key, work)
+    else:
+        folder = work
+    result = Solutions(params, settings, record, folder, point.table)
+    if not cache:
+        weakref.finalize(result, shutil.rmtree, str(work), True)
+    return result
+
+
+def _solve_in(work: Path, params: Params, settings: Settings, tol: dict, label: str):
+    from ..point import solve_point
+
+    start = time.perf_counter()
+    try:
+        return solve_point(params, settings, Tolerances(**tol), folder=work, title=label)
+    except (CotmError, KeyboardInterrupt) as exc:
+        failed = Path(tempfile.mkdtemp(prefix="cotm-failed-"))
+        shutil.copytree(work, failed, dirs_exist_ok=True)
+        shutil.rmtree(work, ignore_errors=True)
+        _failure_record(failed, params, settings, label, exc, time.perf_counter() - start)
+        if isinstance(exc, CotmError):
+            exc.folder = failed
+        raise
+
+
+def _failure_record(folder, params, settings, label, exc, seconds) -> None:
+    from ..versions import versions
+
+    write_json(
+        folder / RUN_JSON,
+        {
+            "label": label,
+            "created": timestamp(),
+            "status": "failed",
+            "error": f"{type(exc).__name__}: {exc}",
+            "parameters": params.as_dict(),
+            "settings": settings.as_dict(),
+            "versions": versions(),
+            "timings": {"total": seconds},
+        },
+    )
+
+
+def _tolerances(tolerances: Tolerances | dict | None) -> dict:
+    if tolerances is None:
+        tolerances = Tolerances()
+    elif isinstance(tolerances, dict):
+        known = {f.name for f in fields(Tolerances)}
+        for name in tolerances:
+            if name not in known:
+                raise ParameterError(f"{name}: unknown tolerance (known: {' '.join(known)})")
+        tolerances = Tolerances(**tolerances)
+    return asdict(tolerances)

@@ -1,0 +1,171 @@
+"""`sweep` and its result, `Sweep`: every equilibrium along one or two parameter ranges."""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+from ..errors import ParameterError
+from ..fs import cache_root, output_root, write_json
+from ..params import Params
+from ..settings import Settings
+
+
+class Sweep:
+    """A finished sweep: `table` (sweep.csv), `events` (events.csv), `record` (run.json)."""
+
+    def __init__(self, spec, folder: Path, record: dict):
+        self.spec = spec
+        self.folder = Path(folder)
+        self.record = record
+        self._table = None
+        self._events = None
+
+    def __repr__(self) -> str:
+        return (
+            f"<Sweep {self.spec.param} x {len(self.spec.values)}"
+            + (f", {self.spec.param2} x {len(self.spec.values2)}" if self.spec.param2 else "")
+            + f": {self.record['rows']} rows, {self.record['events']} events in {self.folder}>"
+        )
+
+    @property
+    def table(self):
+        """One row per finite solution per point (pandas DataFrame, the sweep.csv columns)."""
+        if self._table is None:
+            from ..analysis.classify import read_table
+
+            self._table = read_table(self.folder / "sweep.csv")
+        return self._table
+
+    @property
+    def events(self):
+        """Folds, pitchforks, stability and physical changes, refined (events.csv)."""
+        if self._events is None:
+            import pandas as pd
+
+            self._events = pd.read_csv(self.folder / "events.csv")
+        return self._events
+
+    @property
+    def status(self) -> str:
+        """'ok', or 'incomplete' when some point's completeness check failed."""
+        return self.record["status"]
+
+    def plot(self, path: str | Path | None = None, show_all: bool = False) -> list[Path]:
+        """The bifurcation diagram (1-D) or the stable-count map (2-D).
+
+        `path` with a suffix (.png, .svg, .pdf) writes that file; without one, `<path>.png` and
+        `<path>.svg`; by default `bifurcation` or `counts` in the sweep folder.
+        """
+        one_d = self.spec.param2 is None
+        path = (
+            Path(path) if path is not None else self.folder / ("bifurcation" if one_d else "counts")
+        )
+        if one_d:
+            from ..plot.bifurcation import plot_bifurcation
+
+            written = plot_bifurcation(
+                self.table, self.spec.param, path, show_all=show_all, events=self.events
+            )
+        else:
+            from ..plot.counts import plot_sweep_counts
+
+            written = plot_sweep_counts(self.table, self.spec.columns, path)
+        inside = [p.name for p in written if p.parent.resolve() == self.folder.resolve()]
+        if inside:
+            self.record["figures"] = sorted(set(self.record.get("figures", [])) | set(inside))
+            write_json(self.folder / "run.json", self.record)
+        return written
+
+
+def sweep(
+    params: Params,
+    param: str,
+    values: Sequence[float],
+    settings: Settings | None = None,
+    *,
+    param2: str | None = None,
+    values2: Sequence[float] | None = None,
+    workers: int = 1,
+    scheduler: str | None = None,
+    out: str | Path | None = None,
+    progress: bool | Callable[[int, int, int], None] = False,
+    command: list[str] | None = None,
+    **options,
+) -> Sweep:
+    """Solve `params` at every value of `param` (and of `param2`: a grid), then find branches
+    and events. Options are Settings fields, as for `solve`.
+
+    The points are solved on `workers` local processes (or a Dask cluster at `scheduler`) and
+    stored one by one under `out` (default: the cache folder), so the same request resumes where
+    it stopped and an unchanged finished sweep is not solved again.
+    """
+    from ..continuation.runner import prepare
+    from ..continuation.spec import SweepSpec
+
+    settings = (settings or Settings()).replace(**options)
+    spec = SweepSpec(
+        params.as_dict(), param, tuple(values), param2,
+        None if values2 is None else tuple(values2), settings.as_dict(),
+    )  # fmt: skip
+    root = cache_root() / "sweeps" if out is None else output_root(out)
+    folder = prepare(spec, root / spec.folder_name())
+    return _run(spec, folder, workers, scheduler, progress, command)
+
+
+def _run(spec, folder: Path, workers: int, scheduler, progress, command) -> Sweep:
+    """Solve a prepared sweep folder's pending points and finish it."""
+    from ..continuation.results import finish
+    from ..continuation.runner import pending_points, run_points
+
+    bar, callback = _progress(progress, len(spec.grid()), len(pending_points(spec, folder)))
+    try:
+        stats = run_points(spec, folder, workers=workers, scheduler=scheduler, progress=callback)
+    finally:
+        if bar is not None:
+            bar.close()
+    record = finish(spec, folder, stats, workers=workers, scheduler=scheduler, command=command)
+    return Sweep(spec, folder, record)
+
+
+def resume_sweep(
+    folder: str | Path,
+    workers: int = 1,
+    scheduler: str | None = None,
+    progress: bool | Callable[[int, int, int], None] = False,
+    command: list[str] | None = None,
+) -> Sweep:
+    """Continue the sweep stored in `folder` (after an interruption) and finish it."""
+    from ..continuation.runner import load_spec
+
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise ParameterError(f"--resume {str(folder)!r}: no such folder")
+    return _run(load_spec(folder), folder, workers, scheduler, progress, command)
+
+
+def _progress(progress, total: int, pending: int):
+    """A tqdm bar on a terminal, a line every 10 % otherwise; or the caller's callback."""
+    if callable(progress):
+        return None, progress
+    if not progress:
+        return None, None
+    done0 = total - pending
+    if sys.stderr.isatty():
+        from tqdm import tqdm
+
+        bar = tqdm(total=total, initial=done0, unit="pt", desc="sweep", file=sys.stderr)
+
+        def update(done: int, _todo: int, lost: int) -> None:
+            bar.update(1)
+            bar.set_postfix(lost_paths=lost)
+
+        return bar, update
+    step = max(1, pending // 10)
+
+    def lines(done: int, todo: int, lost: int) -> None:
+        if done % step == 0 or done == todo:
+            print(f"sweep: {done0 + done}/{total} points, {lost} paths lost", file=sys.stderr)
+
+    return None, lines

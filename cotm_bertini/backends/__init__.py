@@ -1,0 +1,1 @@
+"""Solver backends: render, run and parse, each producing one typed endpoint table."""

@@ -1,0 +1,415 @@
+"""The `homotopy` engine: Bertini 2 in-process, by parameter homotopy from a generic solution set.
+
+A total-degree solve (ab initio) at random complex parameters p0 gives the generic solution set.
+Any real target p1 is then reached by tracking those solutions while every parameter moves on
+the straight line from p0 (t = 1) to p1 (t = 0): since p0 is random complex, the line misses the
+parameter values where paths meet (the "gamma trick"). This is the Paramotopy / HomotopyContinuation
+approach; the `bertini2` command cannot do it, the `bertini` module can.
+
+The singular roots of the generic set are the d = 0 artefacts (a spring with L0 > 0 at zero
+length, see the reference notes): they are not tracked but computed at the target in closed form.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import SolverError
+from ..fs import atomic_write_text, cache_root
+from ..model.artefacts import zero_length_points
+from ..model.polynomial import ParametricSystem
+from ..params import Params
+from ..settings import Settings
+from ..versions import bertini2_version
+from .endpoints import Endpoints
+from .render import render_parameter_homotopy, render_system
+
+_SUCCESS = "Success"
+DOUBLE_FINAL_TOLERANCE = 1e-8
+DOUBLE_MAX_STEPS = 2000
+SECOND_START = 7919  # seed offset of the independent second generic set
+
+
+def _bertini():
+    import bertini
+
+    bertini.recording(False)  # never recall or store runs on disk behind our back
+    return bertini
+
+
+def _code(m) -> str:
+    return str(m.endgame_success_code).rsplit(".", 1)[-1]
+
+
+def _points(pts) -> np.ndarray:
+    return np.array([[complex(z) for z in p] for p in pts], dtype=complex)
+
+
+@dataclass(frozen=True)
+class GenericSet:
+    """The solutions of the system at generic complex parameters: the start of every homotopy."""
+
+    key: str
+    seed: int
+    start: dict[str, complex]
+    points: np.ndarray  # nonsingular finite solutions, tracked to every target
+    paths: int
+    finite_endpoints: int
+    singular_endpoints: int
+    seconds: float
+    bertini_version: str
+
+    def to_json(self) -> dict:
+        """JSON-able form (complex numbers as [re, im])."""
+        return {
+            "key": self.key,
+            "seed": self.seed,
+            "start": {k: [v.real, v.imag] for k, v in self.start.items()},
+            "points": [[[z.real, z.imag] for z in p] for p in self.points],
+            "paths": self.paths,
+            "finite_endpoints": self.finite_endpoints,
+            "singular_endpoints": self.singular_endpoints,
+            "seconds": self.seconds,
+            "bertini_version": self.bertini_version,
+        }
+
+    @classmethod
+    def from_json(cls, d: dict) -> GenericSet:
+        """Inverse of to_json."""
+        pts = np.array([[complex(*z) for z in p] for p in d["points"]], dtype=complex)
+        return cls(
+            d["key"],
+            d["seed"],
+            {k: complex(*v) for k, v in d["start"].items()},
+            pts,
+            d["paths"],
+            d["finite_endpoints"],
+            d["singular_endpoints"],
+            d["seconds"],
+            d["bertini_version"],
+        )
+
+    def summary(self) -> dict:
+        """What run.json records of the generic set."""
+        return {
+            "key": self.key,
+            "seed": self.seed,
+            "paths": self.paths,
+            "finite_endpoints": self.finite_endpoints,
+            "singular_endpoints": self.singular_endpoints,
+            "tracked_points": len(self.points),
+            "solve_seconds": self.seconds,
+            "start_parameters": {k: [v.real, v.imag] for k, v in self.start.items()},
+        }
+
+
+def generic_key(ps: ParametricSystem, seed: int) -> str:
+    """Content hash of what a generic set depends on: equations, seed, engine version."""
+    blob = json.dumps(
+        {"system": ps.to_json(), "seed": seed, "bertini2": bertini2_version(), "scale": {}},
+        sort_keys=True,
+    )
+    return hashlib.sha256(blob.encode()).hexdigest()[:16]
+
+
+def generic_set(ps: ParametricSystem, seed: int = 1, use_cache: bool = True) -> GenericSet:
+    """The generic solution set of `ps` for `seed`, from the disk cache or solved ab initio."""
+    key = generic_key(ps, seed)
+    path = cache_root() / f"generic-{key}.json"
+    if use_cache and path.is_file():
+        try:
+            return GenericSet.from_json(json.loads(path.read_text()))
+        except (ValueError, KeyError):
+            path.unlink(missing_ok=True)  # a damaged cache entry is recomputed, not trusted
+    gs = _solve_generic(ps, seed, key)
+    if use_cache:
+        atomic_write_text(path, json.dumps(gs.to_json()))
+    return gs
+
+
+def _solve_generic(ps: ParametricSystem, seed: int, key: str) -> GenericSet:
+    bertini = _bertini()
+    from bertini import nag_algorithm as na
+
+    rng = np.random.default_rng(seed)
+    # Targets are normalised (Params.normalized): every parameter is of order one, and so is p0.
+    start = {name: complex(*rng.normal(size=2)) / np.sqrt(2) for name in ps.parameters}
+    system = ps.instantiate([start[n] for n in ps.parameters])
+    bertini.random.set_random_seed(seed)
+    t0 = time.perf_counter()
+    solver = na.ZeroDimSolver(bertini.parse.system(render_system(system)))
+    solver.solve(show_progress=False)
+    seconds = time.perf_counter() - t0
+    meta, pts = solver.solution_metadata(), solver.all_solutions()
+    finite = [i for i, m in enumerate(meta) if m.is_finite and _code(m) == _SUCCESS]
+    regular = [i for i in finite if not is_singular(meta[i])]
+    return GenericSet(
+        key,
+        seed,
+        start,
+        _points([pts[i] for i in regular]),
+        len(meta),
+        len(finite),
+        len(finite) - len(regular),
+        seconds,
+        bertini2_version(),
+    )
+
+
+def is_singular(m) -> bool:
+    """Bertini's singular flag: multiplicity > 1 or a condition number over its threshold."""
+    return bool(m.is_singular or m.multiplicity > 1)
+
+
+@dataclass
+class TrackReport:
+    """What tracking to one target did."""
+
+    tracked: int = 0
+    finite: int = 0
+    infinite: int = 0
+    retracked_adaptive: int = 0
+    lost: int = 0
+    method: str = "parameter homotopy"
+    seconds: float = 0.0
+    notes: list[str] = field(default_factory=list)
+
+    def as_dict(self) -> dict:
+        """For run.json and sweep rows."""
+        return {**self.__dict__, "notes": "; ".join(self.notes)}
+
+
+def _configure(solver, settings: Settings, mptype: str, deadline: float | None) -> None:
+    """Every tracking setting the caller passed (Bertini's defaults for the rest)."""
+    options: dict[str, object] = {}
+    if settings.threads is not None:
+        options["num_threads"] = settings.threads
+    if mptype == "double":
+        # The endgame cannot reach Bertini's default 1e-11 in double precision on a few paths
+        # and fails them; 1e-8 is enough, as classification Newton-refines every endpoint.
+        options["final_tolerance"] = DOUBLE_FINAL_TOLERANCE
+        # In double precision a path whose step was cut can crawl for 1e5 steps (tens of
+        # seconds); a normal path takes under a hundred. Give up early: AMP redoes it in ms.
+        options["max_num_steps"] = DOUBLE_MAX_STEPS
+    chosen = {
+        "final_tolerance": settings.final_tol,
+        "newton_before_endgame": settings.tracktol_before_eg,
+        "newton_during_endgame": settings.tracktol_during_eg,
+        "level": settings.security_level,
+        "max_norm": settings.max_norm,
+        "condition_number_threshold": settings.condnum_threshold,
+    }
+    options.update({k: v for k, v in chosen.items() if v is not None})
+    if deadline is not None:
+        remaining = deadline - time.perf_counter()
+        if remaining <= 0:
+            raise SolverError(f"the in-process solve timed out after {settings.timeout:g} s")
+        options["max_solve_wall_clock_duration"] = remaining
+    solver.set(**options)
+
+
+def _track(
+    ps: ParametricSystem,
+    gs: GenericSet,
+    target: dict[str, float],
+    idx: list[int],
+    mptype: str,
+    settings: Settings,
+    deadline: float | None,
+):
+    bertini = _bertini()
+    from bertini import nag_algorithm as na
+
+    hom = bertini.parse.system(render_parameter_homotopy(ps, gs.start, target))
+    tgt = bertini.parse.system(render_system(ps.instantiate([target[n] for n in ps.parameters])))
+    solver = na.HomotopySolver(hom, [gs.points[i] for i in idx], tgt, mptype=mptype)
+    _configure(solver, settings, mptype, deadline)
+    solver.solve(show_progress=False)
+    if deadline is not None and time.perf_counter() > deadline:
+        raise SolverError(f"the in-process solve timed out after {settings.timeout:g} s")
+    return solver.solution_metadata(), solver.all_solutions()
+
+
+def track(
+    ps: ParametricSystem,
+    gs: GenericSet,
+    params: Params,
+    settings: Settings = Settings(),
+    deadline: float | None = None,
+) -> tuple[Endpoints, TrackReport]:
+    """Finite endpoints at `params`, tracked from the generic set.
+
+    Paths are tracked in double precision; with mptype 2 any path that does not end in success
+    is tracked again with adaptive precision (mptype 0 keeps double precision only); a path that
+    still fails is counted as lost (the caller re-solves).
+    """
+    t0 = time.perf_counter()
+    target = {n: getattr(params, n) for n in ps.parameters}
+    n = len(gs.points)
+    rep = TrackReport(tracked=n)
+    meta, pts = _track(ps, gs, target, list(range(n)), "double", settings, deadline)
+    results = {i: (meta[i], pts[i]) for i in range(n)}
+    redo = [i for i in range(n) if _code(meta[i]) != _SUCCESS or not meta[i].is_finite]
+    if _crossing(results, [i for i in range(n) if i not in redo]):
+        redo = list(range(n))
+        rep.notes.append("path crossing in double precision: all paths re-tracked")
+    if redo and settings.mptype == 2:
+        rep.retracked_adaptive = len(redo)
+        meta2, pts2 = _track(ps, gs, target, redo, "adaptive", settings, deadline)
+        for k, i in enumerate(redo):
+            results[i] = (meta2[k], pts2[k])
+    rows = []
+    for i in range(n):
+        m, p = results[i]
+        code = _code(m)
+        if code == _SUCCESS and m.is_finite:
+            rows.append(endpoint_record(i, m, p))
+        elif code in ("GoingToInfinity", "SecurityMaxNormReached") or not m.is_finite:
+            rep.infinite += 1
+        else:
+            rep.lost += 1
+            rep.notes.append(f"path {i}: {code}")
+    rep.finite = len(rows)
+    rep.seconds = time.perf_counter() - t0
+    return Endpoints.from_records(ps.variables, rows), rep
+
+
+def endpoint_record(index: int, m, point) -> dict:
+    """One endpoint's metadata (the Endpoints fields) and coordinates."""
+    d = m.to_dict()
+    return {
+        "path_number": index,
+        "condition_number": float(d["condition_number"]),
+        "function_residual": float(d["function_residual"]),
+        "newton_residual": float(d["newton_residual"]),
+        "final_t": complex(d["final_time_used"]).real,
+        "max_precision": float(d["max_precision_used"]),
+        "accuracy_estimate": float(d["accuracy_estimate_user_coords"]),
+        "cycle_number": int(d["cycle_num"]),
+        "bertini_multiplicity": int(d["multiplicity"]),
+        "coords": [complex(z) for z in point],
+    }
+
+
+def _crossing(results: dict, idx: list[int], tol: float = 1e-7) -> bool:
+    """Two paths ending at the same nonsingular point: one of them jumped."""
+    pts = np.array(
+        [[complex(z) for z in results[i][1]] for i in idx if not is_singular(results[i][0])],
+        dtype=complex,
+    )
+    if len(pts) < 2:
+        return False
+    scale = 1.0 + np.abs(pts).max(axis=1)
+    for a in range(len(pts)):
+        d = np.abs(pts[a + 1 :] - pts[a]).max(axis=1) / np.maximum(scale[a + 1 :], scale[a])
+        if (d < tol).any():
+            return True
+    return False
+
+
+def zero_length_roots(params: Params, variables: tuple[str, ...]) -> Endpoints:
+    """The d = 0 artefacts at `params` in closed form, as endpoints (two paths end at each)."""
+    points = zero_length_points(params, variables)
+    records = [
+        {
+            "path_number": -1,
+            "condition_number": np.inf,
+            "function_residual": 0.0,
+            "newton_residual": 0.0,
+            "final_t": 0.0,
+            "accuracy_estimate": 0.0,
+            "cycle_number": 1,
+            "bertini_multiplicity": 2,
+            "closed_form": True,
+            "coords": point,
+        }
+        for point in points
+    ]
+    return Endpoints.from_records(variables, records)
+
+
+@dataclass(frozen=True)
+class HomotopySolve:
+    """Every finite endpoint at a target and how the homotopy got there."""
+
+    endpoints: Endpoints  # tracked endpoints, then the closed-form d = 0 roots
+    info: dict
+    generic: GenericSet
+    input_text: str
+
+
+def solve_target(
+    ps: ParametricSystem, params: Params, settings: Settings = Settings()
+) -> HomotopySolve:
+    """Every finite endpoint at `params` (tracked ones plus the closed-form d = 0 artefacts).
+
+    Parameter homotopy from the cached generic set. If a path is lost, or fewer finite endpoints
+    arrive than the generic count, the point is tracked again from a second, independent generic
+    set (a new random start, like Paramotopy's new gamma); if that does not settle it, the target
+    is solved ab initio. `info["method"]` says which, `info["lost"]` how many paths were lost.
+
+    The target is solved in units of L3 and max(k1, k2) (equilibria do not change when every
+    length, or every stiffness, is scaled), so the paths see numbers of order one whatever the
+    user's units; the spring lengths are scaled back.
+    """
+    deadline = None if settings.timeout is None else time.perf_counter() + settings.timeout
+    gs = generic_set(ps, settings.seed)
+    unit = params.normalized()
+    target = {n: getattr(unit, n) for n in ps.parameters}
+    endpoints, rep = track(ps, gs, unit, settings, deadline)
+    method = "parameter homotopy" + (" + adaptive retrack" if rep.retracked_adaptive else "")
+    if rep.lost or rep.finite < len(gs.points):
+        gs2 = generic_set(ps, settings.seed + SECOND_START)
+        endpoints2, rep2 = track(ps, gs2, unit, settings, deadline)
+        if rep2.lost == 0 and not rep.lost and rep2.finite == rep.finite:
+            method += "; finite count confirmed from a second start"
+        elif rep2.lost == 0 and rep2.finite >= rep.finite:
+            endpoints, rep = endpoints2, rep2
+            method = "parameter homotopy from a second start (the first lost paths)"
+        else:
+            endpoints = ab_initio(ps, unit, settings)
+            method = "ab initio (both parameter homotopies lost paths)"
+    is_d = np.array([v.startswith("d") for v in ps.variables])
+    endpoints = endpoints.with_points(
+        np.where(is_d, endpoints.points * params.L3, endpoints.points)
+    )
+    info = {
+        **rep.as_dict(),
+        "method": method,
+        "units": {"length": params.L3, "stiffness": max(params.k1, params.k2)},
+        "generic_key": gs.key,
+        "generic_paths": gs.paths,
+        "generic_finite": gs.finite_endpoints,
+    }
+    closed = zero_length_roots(params, ps.variables)
+    text = render_parameter_homotopy(ps, gs.start, target)
+    return HomotopySolve(endpoints.concat(closed), info, gs, text)
+
+
+def ab_initio(ps: ParametricSystem, params: Params, settings: Settings = Settings()) -> Endpoints:
+    """Total-degree solve at the target itself (in-process): the last resort.
+
+    Its singular endpoints (the d = 0 artefacts) are dropped: the closed form reports them.
+    """
+    bertini = _bertini()
+    from bertini import nag_algorithm as na
+
+    bertini.random.set_random_seed(settings.seed)
+    system = ps.instantiate([getattr(params, n) for n in ps.parameters])
+    solver = na.ZeroDimSolver(bertini.parse.system(render_system(system)))
+    if settings.threads is not None:
+        solver.set(num_threads=settings.threads)
+    solver.solve(show_progress=False)
+    rows = [
+        endpoint_record(i, m, p)
+        for i, (m, p) in enumerate(
+            zip(solver.solution_metadata(), solver.all_solutions(), strict=True)
+        )
+        if m.is_finite and _code(m) == _SUCCESS and not is_singular(m)
+    ]
+    return Endpoints.from_records(ps.variables, rows)

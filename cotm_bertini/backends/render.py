@@ -1,0 +1,133 @@
+"""Render polynomial systems and solver settings as solver input text (Jinja2 templates)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from functools import lru_cache
+
+import numpy as np
+
+from ..model.polynomial import ParametricSystem, PolySystem
+from ..resources import template_texts
+from ..settings import Settings
+
+
+@lru_cache(maxsize=1)
+def _environment():
+    import jinja2
+
+    return jinja2.Environment(
+        loader=jinja2.DictLoader(template_texts()),
+        undefined=jinja2.StrictUndefined,
+        trim_blocks=True,
+        lstrip_blocks=True,
+        keep_trailing_newline=True,
+    )
+
+
+def bertini_number(c: float) -> str:
+    """A real literal that round-trips: repr (Bertini reads its e-notation)."""
+    return repr(float(c))
+
+
+def phc_number(c: float) -> str:
+    """A real literal that round-trips in PHCpack's E notation (17 significant digits)."""
+    return f"{float(c):.16E}"
+
+
+def complex_number(z: complex) -> str:
+    """A Bertini literal for a (possibly complex) number: (re+im*I)."""
+    z = complex(z)
+    if z.imag == 0:
+        return f"({bertini_number(z.real)})"
+    sign = "+" if z.imag >= 0 else "-"
+    return f"({bertini_number(z.real)}{sign}{bertini_number(abs(z.imag))}*I)"
+
+
+def _monomial(names: tuple[str, ...], exps: np.ndarray) -> str:
+    return "*".join(n if e == 1 else f"{n}^{int(e)}" for n, e in zip(names, exps, strict=True) if e)
+
+
+def polynomial_text(
+    names: tuple[str, ...],
+    exps: np.ndarray,
+    coeffs: np.ndarray,
+    number: Callable[[float], str] = bertini_number,
+) -> str:
+    """One polynomial as text, terms in a fixed graded order; complex coefficients as (a+b*I)."""
+    if np.iscomplexobj(coeffs) and np.any(np.imag(coeffs) != 0):
+        terms = [
+            complex_number(c) + (f"*{_monomial(names, e)}" if e.any() else "")
+            for e, c in zip(exps, coeffs, strict=True)
+        ]
+        return " + ".join(terms) if terms else "0"
+    coeffs = np.real(coeffs)
+    order = sorted(range(len(coeffs)), key=lambda i: (-int(exps[i].sum()), tuple(-exps[i])))
+    parts = []
+    for i in order:
+        c, mono = float(coeffs[i]), _monomial(names, exps[i])
+        mag = number(abs(c))
+        term = mono if (mono and mag == "1.0") else (f"{mag}*{mono}" if mono else mag)
+        parts.append(("- " if c < 0 else "+ ") + term)
+    if not parts:
+        return "0"
+    text = " ".join(parts)
+    return text[2:] if text.startswith("+ ") else "-" + text[2:]
+
+
+def variable_groups(system: PolySystem, settings: Settings) -> list[list[str]]:
+    """One group of all variables, or {c1,s1},{c2,s2},{d1},{d2} for a multihomogeneous start."""
+    if settings.variable_groups == "total_degree":
+        return [list(system.variables)]
+    groups = [["c1", "s1"], ["c2", "s2"]]
+    groups += [[v] for v in system.variables if v.startswith("d")]
+    return groups
+
+
+def _functions(system: PolySystem) -> list[dict[str, str]]:
+    return [
+        {"name": n, "text": polynomial_text(system.variables, e, c)}
+        for n, e, c in zip(system.names, system.exponents, system.coefficients, strict=True)
+    ]
+
+
+def render_input(
+    system: PolySystem, settings: Settings, params: dict[str, float], title: str = ""
+) -> str:
+    """The Bertini classic input file text for `system` under `settings`."""
+    return (
+        _environment()
+        .get_template("zero_dim.input.j2")
+        .render(
+            title=title or "CoTM equilibria",
+            params=params,
+            config=settings.bertini_config(),
+            variable_groups=variable_groups(system, settings),
+            functions=_functions(system),
+        )
+    )
+
+
+def render_system(system: PolySystem) -> str:
+    """A bare INPUT section (no CONFIG) for Bertini 2's in-process parser; complex allowed."""
+    return (
+        _environment()
+        .get_template("system.input.j2")
+        .render(variables=system.variables, functions=_functions(system))
+    )
+
+
+def render_parameter_homotopy(
+    ps: ParametricSystem, start: dict[str, complex], target: dict[str, complex]
+) -> str:
+    """INPUT section of the homotopy moving the parameters from `start` (t=1) to `target` (t=0)."""
+    parameters = [
+        {"name": n, "start": complex_number(start[n]), "target": complex_number(target[n])}
+        for n in ps.parameters
+    ]
+    functions = [{"name": n, "text": t} for n, t in zip(ps.names, ps.texts, strict=True)]
+    return (
+        _environment()
+        .get_template("parameter_homotopy.input.j2")
+        .render(variables=ps.variables, parameters=parameters, functions=functions)
+    )

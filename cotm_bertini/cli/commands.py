@@ -1,0 +1,207 @@
+"""The subcommands: each translates its options, calls the library and reports."""
+
+from __future__ import annotations
+
+import argparse
+import shutil
+import sys
+import time
+from pathlib import Path
+
+from ..errors import ParameterError, SolverError
+from ..fs import link_latest, new_run_folder, output_root
+from .options import (
+    EXIT_DISAGREE,
+    EXIT_INCOMPLETE,
+    EXIT_OK,
+    label_of,
+    overrides,
+    params_from,
+    settings_from,
+)
+
+
+def _warn(warnings: list[str]) -> None:
+    for text in warnings:
+        print(f"cotm-bertini: warning: {text}", file=sys.stderr)
+
+
+def _files_line(folder: Path) -> str:
+    files = sorted(p.name for p in folder.iterdir() if p.is_file())
+    return f"files in {folder}: {', '.join(files)}"
+
+
+def solve(args: argparse.Namespace) -> int:
+    """`solve`: one parameter set, a run folder under runs/<label>/."""
+    from ..api.solutions import solve as solve_params
+
+    start = time.perf_counter()
+    params, settings, label = params_from(args), settings_from(args), label_of(args)
+    root = output_root(args.out) if args.out else Path("runs") / label
+    output_root(root)
+    try:
+        res = solve_params(params, settings, cache=not args.no_cache, label=label)
+    except SolverError as exc:
+        folder = getattr(exc, "folder", None)
+        if folder is not None:
+            kept = new_run_folder(root)
+            kept = kept.with_name(kept.name + "-failed")
+            shutil.move(str(folder), kept)
+            print(f"cotm-bertini: the solver's files are in {kept}", file=sys.stderr)
+        raise
+    folder = res.save(new_run_folder(root), plots=not args.no_plots, command=sys.argv[:])
+    link_latest(root, folder)
+    _warn(res.warnings)
+    print(folder if args.quiet else f"{label}: {res.summary}\n{_files_line(folder)}")
+    if res.cache_hit:
+        print(
+            f"cache: answered from a solve of {res.record['cache']['solved']} (key "
+            f"{res.record['cache']['key']}) in {(time.perf_counter() - start) * 1e3:.0f} ms; "
+            "--no-cache solves again",
+            file=sys.stderr,
+        )
+    return EXIT_OK if res.status == "ok" else EXIT_INCOMPLETE
+
+
+def _sweep_spec_values(args: argparse.Namespace, which: str) -> tuple[float, ...] | None:
+    from ..continuation.spec import DEFAULT_RANGES, linspace
+
+    suffix = "2" if which == "param2" else ""
+    name = getattr(args, which)
+    if name is None:
+        for opt in ("start", "stop", "points"):
+            if getattr(args, opt + suffix, None) is not None and suffix:
+                raise ParameterError(
+                    f"--{opt.replace('start', 'from').replace('stop', 'to')}2 "
+                    "given without --param2"
+                )
+        return None
+    start, stop = getattr(args, "start" + suffix), getattr(args, "stop" + suffix)
+    points = getattr(args, "points" + suffix)
+    if start is None or stop is None:
+        if name not in DEFAULT_RANGES:
+            flag = "--from" + suffix if start is None else "--to" + suffix
+            raise ParameterError(
+                f"{flag} is required for --{which} {name} (only "
+                f"{', '.join(DEFAULT_RANGES)} have a default range)"
+            )
+        lo, hi = DEFAULT_RANGES[name]
+        start, stop = lo if start is None else start, hi if stop is None else stop
+    if points is None:
+        raise ParameterError(f"--points{suffix} is required with --{which} {name}")
+    return linspace(name, start, stop, points)
+
+
+def sweep(args: argparse.Namespace) -> int:
+    """`sweep`: a 1-D range or a 2-D grid, resumable; sweep.csv, events.csv, figures."""
+    from ..api.sweeps import resume_sweep
+    from ..api.sweeps import sweep as sweep_params
+    from ..continuation.runner import default_workers
+    from ..params import make_params
+
+    workers = default_workers() if args.workers is None else args.workers
+    if isinstance(workers, int) and workers < 1:
+        raise ParameterError(f"--workers {workers}: must be >= 1")
+    progress = not args.quiet
+    if args.resume:
+        sw = resume_sweep(args.resume, workers, args.scheduler, progress, sys.argv[:])
+    else:
+        values = _sweep_spec_values(args, "param")
+        values2 = _sweep_spec_values(args, "param2")
+        base = make_params(None, overrides(args))
+        sw = sweep_params(
+            base, args.param, values, settings_from(args), param2=args.param2,
+            values2=values2, workers=workers, scheduler=args.scheduler,
+            out=output_root(args.out), progress=progress, command=sys.argv[:],
+        )  # fmt: skip
+    figures = [] if args.no_plots else sw.plot(show_all=args.all)
+    rec, stats = sw.record, sw.record["stats"]
+    print(
+        f"{rec['rows']} rows at {rec['points']} points ({stats['skipped']} resumed), "
+        f"{rec['events']} events, {stats['seconds']:.1f} s solving"
+    )
+    names = ", ".join(p.name for p in figures)
+    print(
+        f"files: {sw.folder}/sweep.csv, events.csv, columns.md, run.json"
+        + (f", {names}" if names else "")
+    )
+    if sw.status != "ok":
+        print(
+            f"cotm-bertini: warning: {len(rec['incomplete_points'])} points failed a "
+            "completeness check (column status); equilibria may be missing there",
+            file=sys.stderr,
+        )
+        return EXIT_INCOMPLETE
+    return EXIT_OK
+
+
+def _verify_text(label: str, res, results) -> str:
+    c = res.counts
+    lines = [
+        f"{label}: Bertini finds {c['distinct_solutions']} distinct finite solutions "
+        f"({c['real']} real, {c['physical']} physical)"
+    ]
+    width = max(len(r.route) for r in results)
+    for r in results:
+        verdict = {True: "agrees", False: "DISAGREES", None: "n/a"}[r.agrees]
+        gap = (
+            ""
+            if r.max_disagreement_deg != r.max_disagreement_deg
+            else (f", max gap {r.max_disagreement_deg:.1e} deg")
+        )
+        note = f" ({r.note})" if r.note else ""
+        lines.append(f"  {r.route:<{width}}  {verdict:<9} {r.found}{gap}{note}")
+    bad = [r.route for r in results if r.agrees is False]
+    lines.append("all routes agree" if not bad else f"disagreement: {', '.join(bad)}")
+    return "\n".join(lines)
+
+
+def verify(args: argparse.Namespace) -> int:
+    """`verify`: the independent routes against the solver's solutions."""
+    from dataclasses import asdict
+
+    from ..analysis.verify import verify as verify_routes
+    from ..api.solutions import solve as solve_params
+    from ..fs import write_json
+
+    params, label = params_from(args), label_of(args)
+    output = output_root(args.out) if args.out else None
+    res = solve_params(params, settings_from(args), label=label)
+    results = verify_routes(params, res.table, seed=args.seed or 1)
+    text = _verify_text(label, res, results)
+    print(text)
+    ok = not any(r.agrees is False for r in results)
+    if output is not None:
+        write_json(
+            output / "verify.json",
+            {
+                "label": label,
+                "ok": ok,
+                "parameters": params.as_dict(),
+                "counts": res.counts,
+                "routes": [asdict(r) for r in results],
+                "report": text,
+            },
+        )
+        print(f"file: {output / 'verify.json'}")
+    return EXIT_OK if ok else EXIT_DISAGREE
+
+
+def paper(args: argparse.Namespace) -> int:
+    """`paper`: Tables 2-4 of the paper matched to our solutions, with and without k2/k1."""
+    from ..paper.compare import compare_with_paper
+
+    out = output_root(args.out)
+    verdict = compare_with_paper(out, seed=args.seed)
+    print(verdict)
+    return EXIT_OK
+
+
+def params(args: argparse.Namespace) -> int:
+    """`params`: the parameter set a command line describes (Table 1 by default), as TOML."""
+    from ..params import PARAM_MEANING, PARAM_UNITS, make_params
+
+    p = make_params(args.case, overrides(args))
+    for name, value in p.as_dict().items():
+        print(f"{name} = {value!r}  # {PARAM_UNITS[name]}, {PARAM_MEANING[name]}")
+    return EXIT_OK

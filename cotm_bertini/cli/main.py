@@ -1,0 +1,115 @@
+"""Command line: `cotm-bertini solve|sweep|verify|paper|params` (docs/cli.md)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from .._version import __version__
+from ..errors import CotmError, ParameterError, SolverError
+from . import commands
+from .options import (
+    EXIT_SOLVER,
+    EXIT_USAGE,
+    Parser,
+    add_case,
+    add_params,
+    add_settings,
+)
+
+
+def _version_text() -> str:
+    from ..versions import bertini2_version
+
+    return f"cotm-bertini {__version__} (bertini2 {bertini2_version()})"
+
+
+def _solve_parser(sub) -> None:
+    s = sub.add_parser("solve", help="every equilibrium of one parameter set")
+    add_case(s)
+    add_params(s)
+    add_settings(s)
+    s.add_argument("--out", metavar="DIR", help="root of run folders (default runs/<label>)")
+    s.add_argument(
+        "--no-plots", action="store_true", help="skip the figures (and the import of matplotlib)"
+    )
+    s.add_argument(
+        "--no-cache", action="store_true", help="solve even if an identical request was answered"
+    )
+    s.add_argument("--quiet", action="store_true", help="print only where the files are")
+    s.set_defaults(run=commands.solve)
+
+
+def _sweep_parser(sub) -> None:
+    w = sub.add_parser(
+        "sweep",
+        help="solve along a parameter range (or a 2-D grid)",
+        description="Solve at evenly spaced values of one parameter (or a grid of two). "
+        "--from and --to are required except for L01 and L02 (default 0 to 12 m, the paper's "
+        "Figs 5-6).",
+    )
+    w.add_argument("--param", default="L01", help="swept parameter (default L01)")
+    w.add_argument("--from", dest="start", type=float, help="first value")
+    w.add_argument("--to", dest="stop", type=float, help="last value")
+    w.add_argument("--points", type=int, default=241, help="number of values (default 241)")
+    w.add_argument("--param2", help="a second swept parameter: a 2-D grid")
+    w.add_argument("--from2", dest="start2", type=float, help="first value of --param2")
+    w.add_argument("--to2", dest="stop2", type=float, help="last value of --param2")
+    w.add_argument("--points2", type=int, help="number of values of --param2")
+    add_params(w)
+    add_settings(w)
+    w.add_argument("--workers", type=int, help="local processes (default: one per core)")
+    w.add_argument("--scheduler", metavar="ADDRESS", help="a Dask scheduler, tcp://host:8786")
+    w.add_argument("--out", metavar="DIR", default="runs", help="root of sweep folders (runs)")
+    w.add_argument("--resume", metavar="DIR", help="continue the sweep stored in DIR")
+    w.add_argument("--all", action="store_true", help="plot the non-physical real roots too")
+    w.add_argument("--no-plots", action="store_true", help="skip the figures")
+    w.add_argument("--quiet", action="store_true", help="no progress report")
+    w.set_defaults(run=commands.sweep, case=None)
+
+
+def _verify_parser(sub) -> None:
+    v = sub.add_parser("verify", help="cross-check one parameter set by independent routes")
+    add_case(v)
+    add_params(v)
+    add_settings(v)
+    v.add_argument("--out", metavar="DIR", help="also write verify.csv and verify.json there")
+    v.set_defaults(run=commands.verify)
+
+
+def _parser() -> argparse.ArgumentParser:
+    ap = Parser(prog="cotm-bertini", description=__doc__)
+    ap.add_argument("--version", action="version", version=_version_text())
+    sub = ap.add_subparsers(dest="command", required=True, parser_class=Parser)
+    _solve_parser(sub)
+    _sweep_parser(sub)
+    _verify_parser(sub)
+    pp = sub.add_parser("paper", help="compare Tables 2-4 of the paper with our solutions")
+    pp.add_argument("--out", metavar="DIR", default="runs/paper", help="default runs/paper")
+    pp.add_argument("--seed", type=int, default=1, help="solver seed (default 1)")
+    pp.set_defaults(run=commands.paper)
+    pr = sub.add_parser("params", help="print the parameters (Table 1 and a case preset)")
+    add_case(pr)
+    add_params(pr)
+    pr.set_defaults(run=commands.params)
+    return ap
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the console script."""
+    args = _parser().parse_args(argv)
+    try:
+        return args.run(args)
+    except ParameterError as exc:
+        print(f"cotm-bertini: error: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    except SolverError as exc:
+        print(f"cotm-bertini: solver failed: {exc}", file=sys.stderr)
+        return EXIT_SOLVER
+    except CotmError as exc:
+        print(f"cotm-bertini: error: {exc}", file=sys.stderr)
+        return EXIT_SOLVER
+
+
+if __name__ == "__main__":
+    sys.exit(main())

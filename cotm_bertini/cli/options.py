@@ -1,0 +1,117 @@
+"""Options shared by the subcommands, and their translation into Params and Settings."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..params import CASES, PARAM_NAMES, Params, load_toml, make_params, parse_assignment
+from ..settings import Settings
+
+# Exit codes (docs/cli.md).
+EXIT_OK = 0
+EXIT_DISAGREE = 1
+EXIT_USAGE = 2
+EXIT_SOLVER = 3
+EXIT_CERTIFICATE = 4
+EXIT_INCOMPLETE = 5
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse with one-line errors and exit code 2."""
+
+    def error(self, message: str) -> None:
+        self.exit(EXIT_USAGE, f"cotm-bertini: error: {message}\n")
+
+
+DEFAULT_CASE = "case3"
+
+
+def add_case(p: argparse.ArgumentParser) -> None:
+    """The positional case preset."""
+    p.add_argument(
+        "case",
+        nargs="?",
+        choices=sorted(CASES),
+        help="preset for L01/L02 (case1: 0, 0; case2: 11.5, 0; case3: 11.5, 11.5); "
+        f"default {DEFAULT_CASE}",
+    )
+
+
+def add_params(p: argparse.ArgumentParser) -> None:
+    """--params FILE and --set NAME=VALUE."""
+    p.add_argument(
+        "--params",
+        metavar="FILE.toml",
+        help=f"TOML file with any of: {' '.join(PARAM_NAMES)} (the rest: Table 1)",
+    )
+    p.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="override one parameter (repeatable; applied after --params)",
+    )
+
+
+def add_settings(p: argparse.ArgumentParser) -> None:
+    """The solver settings every solving subcommand accepts (all honoured or refused)."""
+    p.add_argument("--seed", type=int, help="random seed of the solver (default 1)")
+    p.add_argument(
+        "--engine",
+        choices=("homotopy", "cli"),
+        help="homotopy: parameter homotopy in-process from a cached generic solution set "
+        "(default); cli: total-degree solve by the bertini2 command (or --bertini)",
+    )
+    p.add_argument(
+        "--mptype",
+        type=int,
+        choices=(0, 1, 2),
+        help="precision: 0 double, 1 fixed higher (cli engine only), 2 adaptive (default)",
+    )
+    p.add_argument(
+        "--timeout",
+        type=float,
+        help="seconds before the solve is stopped (default: 600 for cli, none in-process)",
+    )
+    p.add_argument("--threads", type=int, help="solver threads (default: every core)")
+    p.add_argument(
+        "--bertini",
+        metavar="PATH",
+        help="a Bertini 1.x binary instead of bertini2 (implies --engine cli; also $COTM_BERTINI)",
+    )
+
+
+def overrides(args: argparse.Namespace) -> dict[str, float]:
+    """--params FILE.toml, then each --set NAME=VALUE."""
+    values: dict[str, float] = {}
+    if args.params:
+        values.update(load_toml(args.params))
+    for text in args.set:
+        name, value = parse_assignment(text)
+        values[name] = value
+    return values
+
+
+def params_from(args: argparse.Namespace) -> Params:
+    """The parameters a command line asks for: Table 1, the case, the file, the --set's."""
+    return make_params(args.case or DEFAULT_CASE, overrides(args))
+
+
+def label_of(args: argparse.Namespace) -> str:
+    """A run's label: the case named, else the parameter file's name, else `custom` for --set."""
+    if args.case:
+        return args.case
+    if args.params:
+        return Path(args.params).stem
+    return "custom" if args.set else DEFAULT_CASE
+
+
+def settings_from(args: argparse.Namespace) -> Settings:
+    """Settings from the options the user gave (the others stay at their defaults)."""
+    given = {
+        name: getattr(args, name)
+        for name in ("seed", "engine", "mptype", "timeout", "threads", "bertini")
+        if getattr(args, name, None) is not None
+    }
+    return Settings(**given)

@@ -1,0 +1,93 @@
+"""What every column of solutions.csv, sweep.csv and events.csv means (written into each run)."""
+
+from __future__ import annotations
+
+SOLUTIONS = {
+    "solution_id": "1, 2, ...: physical rows first, then other real roots, then complex ones; "
+    "within each group by angle",
+    "gamma1_deg, gamma2_deg": "the angles (deg) in [0, 360); for a non-real solution the real "
+    "part of the complex angle gamma = -i log(c + i s)",
+    "d1, d2": "spring lengths (m): the solver's signed length variable for a spring with L0 > 0, "
+    "the geometric length |P| for a zero-free-length spring",
+    "is_real": "every variable has |Im| < 1e-8 relative to 1 + |Re| (for a singular root "
+    "10 sqrt(tracking accuracy), at most 1e-4)",
+    "max_imag": "the largest |Im| / (1 + |Re|) over the variables: how far from real",
+    "physical": "real, both spring lengths > 0, and not a zero-length artefact",
+    "stable": "physical, not singular, and the Hessian of the energy V in (gamma1, gamma2) is "
+    "positive definite: a strict local minimum of V",
+    "residual": "max |f_i| of the polynomial system at the reported point after Newton "
+    "refinement, in units of L3 and max(k1, k2)",
+    "condition_number": "the solver's estimate (1/rco for PHCpack), the largest over the "
+    "endpoints merged into this row; infinite for closed-form d = 0 artefacts",
+    "multiplicity": "how many path endpoints reached this solution",
+    "reason": "why a row is not physical: complex, negative_d (an equilibrium of a mechanism "
+    "with free length -L0) or zero_length_spring (a d = 0 artefact: a spring with L0 > 0 has "
+    "|d| < 1e-5 L3, its ends coincide and its force direction is undefined); empty if physical",
+    "singular": "jacobian_condition > 1e12, or several path endpoints at this solution",
+    "jacobian_condition": "our condition number of the Jacobian at the refined point (units of "
+    "L3 and max(k)): ordinary roots 1e1-1e7, large near a fold, 1e14+ when exactly singular",
+    "kind": "physical rows: min, saddle or max of V, or degenerate (a Hessian eigenvalue within "
+    "1e-9 k L3^2 of 0)",
+    "energy": "V = 1/2 k1 (d1 - L01)^2 + 1/2 k2 (d2 - L02)^2 (J); NaN unless physical",
+    "hess_eig1, hess_eig2": "eigenvalues of the Hessian of V in (gamma1, gamma2), ascending "
+    "(J/rad^2); NaN unless physical",
+    "spring1_force, spring2_force": "f_i = k_i (d_i - L0i), tension > 0 (N); NaN unless physical",
+    "rod_force": "f3 of eq. (5), tension > 0: negative means the rod is in compression (N)",
+    "tensegrity": "both springs in tension and the rod in compression",
+    "paper_stable": "the paper's criterion, for comparison only: every eigenvalue of the Jacobian "
+    "of its tan-half equations has a negative real part (not a mechanical criterion)",
+    "gamma1_imag_deg, gamma2_imag_deg": "imaginary parts of the complex angles (0 for real rows)",
+    "paths": "the path numbers that ended at this solution (-1: computed in closed form)",
+    "<var>_re, <var>_im": "the solver's variables (c1, s1, c2, s2, and d1, d2 where a spring has "
+    "L0 > 0) as computed",
+}
+
+SWEEP = {
+    "point": "index of the sweep point (grid order; the second parameter varies fastest)",
+    "<param>, <param2>": "the swept parameter values at this point (columns named by them)",
+    "solutions.csv columns": "as in solutions.csv, one row per finite solution of the point",
+    "method": "how the point was solved: parameter homotopy (+ adaptive retrack), second start, "
+    "ab initio, or the cli engine",
+    "lost_paths": "paths that failed at this point (empty where the engine does not say)",
+    "status": "ok, or incomplete when the point's Morse count failed or a path was lost",
+    "branch": "1-D sweeps: which branch the row belongs to (secant prediction + one-to-one "
+    "assignment over all finite solutions, so branches continue through folds)",
+}
+
+EVENTS = {
+    "kind": "fold, pitchfork, stability_change or physical_change",
+    "branches": "the branch ids involved (a+b for a fold)",
+    "<param>": "the refined parameter value of the event",
+    "gamma1_deg, gamma2_deg": "the configuration at the event",
+    "refined": "whether Newton (folds) or bisection (other events) converged",
+    "residual": "fold: max |F|, |J v| relative to the coefficients; stability change: "
+    "|eigenvalue| / max |eigenvalue|; physical change: the larger of |d_i| and the relative |F|",
+    "bracket": "accuracy of the value: the last Newton step or the bisection bracket width",
+    "description": "what happens, in words",
+    "lo, hi": "the sweep points on either side",
+    "variables, x, null_vector": "the point in solver variables and, for folds, the null vector",
+}
+
+
+def markdown(title: str, columns: dict[str, str]) -> str:
+    """A Markdown table of columns and their meanings."""
+    lines = [f"## {title}", "", "| column | meaning |", "|---|---|"]
+    lines += [f"| `{name}` | {text} |" for name, text in columns.items()]
+    return "\n".join(lines) + "\n"
+
+
+def reference(*tables: str, title: str = "Columns of the CSV files in this folder") -> str:
+    """The column reference of a run folder: 'solutions', 'sweep', 'events'."""
+    known = {
+        "solutions": ("solutions.csv", SOLUTIONS),
+        "sweep": ("sweep.csv", SWEEP),
+        "events": ("events.csv", EVENTS),
+    }
+    parts = [f"# {title}\n"]
+    parts += [markdown(*known[t]) for t in tables]
+    return "\n".join(parts)
+
+
+def document() -> str:
+    """docs/columns.md: every table's columns."""
+    return reference("solutions", "sweep", "events", title="Columns of the CSV files")

@@ -1,0 +1,1 @@
+"""Continuation: sweeps over parameters, branches across sweep points, events between them."""

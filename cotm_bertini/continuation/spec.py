@@ -1,0 +1,127 @@
+"""What a sweep is: one or two parameters over given values, the rest fixed, the solver settings."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from dataclasses import asdict, dataclass, field
+from itertools import product
+
+from .._version import __version__
+from ..errors import ParameterError
+from ..params import PARAM_NAMES, Params, make_params
+from ..settings import Settings
+
+# Parameters with a documented default range (the paper's Figs 5-6 sweep L01 over 0-12 m).
+DEFAULT_RANGES = {"L01": (0.0, 12.0), "L02": (0.0, 12.0)}
+
+
+def _values(name: str, option: str, values) -> tuple[float, ...]:
+    try:
+        out = tuple(float(v) for v in values)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{option} for {name}: expected numbers, got {values!r}") from None
+    if not out:
+        raise ParameterError(f"{option} for {name}: no values")
+    bad = [v for v in out if not math.isfinite(v)]
+    if bad:
+        raise ParameterError(f"{option} for {name}: {bad[0]!r} is not finite")
+    if len(set(out)) != len(out):
+        dup = next(v for v in out if out.count(v) > 1)
+        raise ParameterError(
+            f"{option} for {name}: the value {dup!r} repeats (the same point would be solved "
+            "more than once)"
+        )
+    return out
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    """The base parameters, the swept parameter(s) and their values, and the settings."""
+
+    base: dict[str, float]
+    param: str
+    values: tuple[float, ...]
+    param2: str | None = None
+    values2: tuple[float, ...] | None = None
+    settings: dict = field(default_factory=lambda: Settings().as_dict())
+
+    def __post_init__(self) -> None:
+        for name, option in ((self.param, "--param"), (self.param2, "--param2")):
+            if name is not None and name not in PARAM_NAMES:
+                raise ParameterError(
+                    f"{option} {name!r}: unknown parameter (known: {' '.join(PARAM_NAMES)})"
+                )
+        object.__setattr__(self, "values", _values(self.param, "values", self.values))
+        if self.param2 is not None:
+            if self.param2 == self.param:
+                raise ParameterError(f"--param2 {self.param2!r}: same as --param")
+            if self.values2 is None:
+                raise ParameterError(f"--param2 {self.param2!r}: needs its values")
+            object.__setattr__(self, "values2", _values(self.param2, "values2", self.values2))
+        elif self.values2 is not None:
+            raise ParameterError("values2 given without param2")
+        Settings(**self.settings)  # validated here, before any work
+        for values in (self.grid()[0], self.grid()[-1]):
+            make_params(None, {**self.base, **values})  # a bad range fails here
+
+    @classmethod
+    def linspace(cls, base: Params, param: str, start: float, stop: float, points: int, **kw):
+        """`points` evenly spaced values of `param` from `start` to `stop`."""
+        return cls(base.as_dict(), param, linspace(param, start, stop, points), **kw)
+
+    @property
+    def columns(self) -> list[str]:
+        """The swept parameters' names, in order."""
+        return [self.param] + ([self.param2] if self.param2 else [])
+
+    def grid(self) -> list[dict[str, float]]:
+        """Every point's swept values, point index = list index (param2 varies fastest)."""
+        if self.param2 is None:
+            return [{self.param: v} for v in self.values]
+        return [{self.param: u, self.param2: w} for u, w in product(self.values, self.values2)]
+
+    def params_at(self, index: int) -> Params:
+        """The full parameter set of grid point `index`."""
+        return Params(**{**self.base, **self.grid()[index]})
+
+    def to_json(self) -> dict:
+        """JSON-able form (see from_json)."""
+        d = asdict(self)
+        d["values"], d["values2"] = list(self.values), self.values2 and list(self.values2)
+        return d
+
+    @classmethod
+    def from_json(cls, d: dict) -> SweepSpec:
+        """Inverse of to_json."""
+        d = dict(d)
+        d["values"] = tuple(d["values"])
+        d["values2"] = None if d.get("values2") is None else tuple(d["values2"])
+        return cls(**d)
+
+    def key(self) -> str:
+        """Content hash: the same request maps to the same folder (and so resumes)."""
+        blob = json.dumps({**self.to_json(), "version": __version__}, sort_keys=True)
+        return hashlib.sha256(blob.encode()).hexdigest()[:10]
+
+    def folder_name(self) -> str:
+        """A readable, unique folder name."""
+        rng = f"{self.param}-{self.values[0]:g}-{self.values[-1]:g}-{len(self.values)}"
+        if self.param2:
+            rng += f"-{self.param2}-{self.values2[0]:g}-{self.values2[-1]:g}-{len(self.values2)}"
+        return f"sweep-{rng}-{self.key()}"
+
+
+def linspace(name: str, start: float, stop: float, points: int) -> tuple[float, ...]:
+    """`points` evenly spaced values; refuses a degenerate request with one line."""
+    if isinstance(points, bool) or not isinstance(points, int) or points < 1:
+        raise ParameterError(f"--points {points!r} for {name}: must be an integer >= 1")
+    if points > 1 and start == stop:
+        raise ParameterError(
+            f"--from {start:g} --to {stop:g} for {name}: an empty range cannot hold {points} "
+            "distinct points (use --points 1, or widen the range)"
+        )
+    import numpy as np
+
+    return tuple(float(v) for v in np.linspace(start, stop, points))

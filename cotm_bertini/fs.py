@@ -1,0 +1,82 @@
+"""Files and folders: the cache folder, atomic writes, run folders (standard library only)."""
+
+from __future__ import annotations
+
+import datetime as dt
+import json
+import os
+import secrets
+import tempfile
+from pathlib import Path
+
+from .errors import ParameterError
+
+
+def cache_root() -> Path:
+    """$COTM_CACHE or ~/.cache/cotm-bertini: derived equations, generic sets, solves, sweeps."""
+    root = os.environ.get("COTM_CACHE") or Path.home() / ".cache" / "cotm-bertini"
+    return Path(root)
+
+
+def atomic_write_text(path: Path, text: str) -> None:
+    """Write text to path via a temporary file in the same folder and an atomic rename."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w") as fh:
+            fh.write(text)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def write_csv(path: Path, frame) -> None:
+    """A CSV that loads straight into pandas or a spreadsheet, written atomically."""
+    atomic_write_text(path, frame.to_csv(index=False))
+
+
+def write_json(path: Path, data: dict) -> None:
+    """Pretty JSON, written atomically."""
+    atomic_write_text(path, json.dumps(data, indent=2, sort_keys=False, default=str) + "\n")
+
+
+def timestamp() -> str:
+    """Local time with zone, to the second, for run records."""
+    return dt.datetime.now().astimezone().isoformat(timespec="seconds")
+
+
+def output_root(path: str | Path, option: str = "--out") -> Path:
+    """A folder to write under: refuse a path that exists and is not a directory."""
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise ParameterError(f"{option} {str(path)!r}: exists and is not a directory")
+    for parent in path.parents:
+        if parent.exists() and not parent.is_dir():
+            raise ParameterError(f"{option} {str(path)!r}: {str(parent)!r} is not a directory")
+    return path
+
+
+def new_run_folder(root: Path) -> Path:
+    """A new, not yet existing folder name under root: <YYYYmmdd-HHMMSS>-<random>."""
+    stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
+    root = output_root(root)
+    root.mkdir(parents=True, exist_ok=True)
+    return root / f"{stamp}-{secrets.token_hex(3)}"
+
+
+def partial_name(final: Path) -> Path:
+    """The hidden working name of a folder that is renamed to `final` when complete."""
+    return final.with_name(f".partial-{final.name}")
+
+
+def link_latest(root: Path, final: Path) -> None:
+    """root/latest -> the newest run folder (replaced atomically; a real file is left alone)."""
+    latest = root / "latest"
+    if latest.is_symlink() or not latest.exists():
+        tmp_link = root / f".latest-{final.name}"
+        tmp_link.symlink_to(final.name)
+        tmp_link.replace(latest)

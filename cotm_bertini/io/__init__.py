@@ -1,0 +1,1 @@
+"""Results on disk: the solve cache, run folders, column references."""

@@ -1,0 +1,121 @@
+"""Run folders: solutions.csv, run.json, columns.md, the input file and the solver's own files."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from ..columns import reference
+from ..errors import ParameterError
+from ..fs import atomic_write_text, partial_name, timestamp, write_csv, write_json
+from ..versions import versions
+
+if TYPE_CHECKING:  # the solve path only: a cache hit must not load numpy or pandas
+    from ..point import PointSolution
+
+SOLUTIONS_CSV = "solutions.csv"
+RUN_JSON = "run.json"
+COLUMNS_MD = "columns.md"
+FIGURE_STEMS = ("configurations", "energy_map")
+SUMMARY_COLUMNS = [
+    "solution_id",
+    "gamma1_deg",
+    "gamma2_deg",
+    "d1",
+    "d2",
+    "physical",
+    "stable",
+    "kind",
+    "reason",
+]
+
+
+def solve_record(point: PointSolution, tolerances: dict, label: str, key: str | None) -> dict:
+    """The run.json content of a solve (the fields a later save adds are not here)."""
+    p = point.params
+    record = {
+        "label": label,
+        "solved": timestamp(),
+        "status": point.status,
+        "warnings": list(point.warnings),
+        "parameters": p.as_dict(),
+        "zero_free_length": {"spring1": p.zfl[0], "spring2": p.zfl[1]},
+        "settings": point.settings.as_dict(),
+        "seed": point.settings.seed,
+        "tolerances": tolerances,
+        "versions": versions(),
+        "engine": point.engine,
+        "details": point.details,
+        "polynomial_system": point.system,
+        "counts": point.counts,
+        "morse": point.morse,
+        "timings": dict(point.timings),
+        "cache_key": key,
+    }
+    record["summary"] = summary_text(record, point.table)
+    return record
+
+
+def summary_text(record: dict, table) -> str:
+    """The console report of a solve: counts, the real solutions (the caller adds a label)."""
+    c, engine = record["counts"], record["engine"]
+    closed = c["closed_form_endpoints"]
+    lines = [
+        f"{c['distinct_solutions']} distinct finite solutions "
+        f"({c['real']} real, {c['physical']} physical, {c['stable']} stable) from "
+        f"{c['finite_endpoints']} finite endpoints of {c['paths_tracked']} paths tracked"
+        + (f" and {closed} computed in closed form" if closed else "")
+        + f"; {engine['flavour']} ({engine['path']} {engine['version']}) "
+        f"{record['timings'].get('solve', 0.0):.2f} s"
+    ]
+    real = table[table["is_real"].astype(bool)]
+    if len(real):
+        shown = real[SUMMARY_COLUMNS].copy()
+        for col in ("gamma1_deg", "gamma2_deg"):
+            # Wrap after rounding to the printed digits: 359.99996 prints as 0.0000, not 360.
+            shown[col] = shown[col].round(4) % 360.0
+        lines.append(shown.to_string(index=False, float_format=lambda v: f"{v:.4f}"))
+    return "\n".join(lines)
+
+
+def write_solution_files(folder: Path, point: PointSolution) -> None:
+    """solutions.csv, columns.md and the input file (unless the solver wrote it)."""
+    write_csv(folder / SOLUTIONS_CSV, point.table)
+    atomic_write_text(folder / COLUMNS_MD, reference("solutions"))
+    if not (folder / "input").exists():
+        atomic_write_text(folder / "input", point.input_text)
+
+
+def read_record(folder: Path) -> dict:
+    """A run folder's run.json."""
+    return json.loads((Path(folder) / RUN_JSON).read_text())
+
+
+def read_solutions(folder: Path):
+    """A run folder's solutions.csv as the table a fresh solve returns."""
+    from ..analysis.classify import read_table
+
+    return read_table(Path(folder) / SOLUTIONS_CSV)
+
+
+def figure_files(folder: Path) -> list[Path]:
+    """The figures present in a run folder."""
+    return sorted(p for p in Path(folder).iterdir() if p.stem in FIGURE_STEMS and p.is_file())
+
+
+def copy_run(source: Path, dest: Path, update: dict, with_figures: bool) -> Path:
+    """A new run folder `dest` with the files of `source` and run.json updated; atomic."""
+    dest = Path(dest)
+    if dest.exists() and (not dest.is_dir() or any(dest.iterdir())):
+        raise ParameterError(f"save {str(dest)!r}: exists and is not an empty folder")
+    work = partial_name(dest)
+    skip = set() if with_figures else {p.name for p in figure_files(source)}
+    shutil.copytree(source, work, ignore=lambda _d, names: [n for n in names if n in skip])
+    record = read_record(work) | update
+    write_json(work / RUN_JSON, record)
+    if dest.exists():
+        dest.rmdir()
+    work.rename(dest)
+    return dest

@@ -1,0 +1,1 @@
+"""The model: kinematics, the equilibrium equations (sympy) and their compiled numeric forms."""

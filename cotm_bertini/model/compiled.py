@@ -1,0 +1,110 @@
+"""The derived equations as fast numeric code, cached on disk so a solve needs no sympy.
+
+`equations` (sympy) is the source of truth. What it derives is kept in the cache folder: each
+structure's ParametricSystem as JSON, and the energy, its gradient and Hessian and the paper's
+tan-half Jacobians as a generated Python module. The cache key is a hash of the derivation's
+source (equations.py, kinematics.py), so an edit of either regenerates them.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import json
+from functools import cache
+from pathlib import Path
+
+import numpy as np
+
+from ..fs import atomic_write_text, cache_root
+from ..params import Params
+from .polynomial import ParametricSystem, PolySystem
+
+_SOURCES = tuple(Path(__file__).resolve().parent / f for f in ("equations.py", "kinematics.py"))
+
+
+@cache
+def _source_hash() -> str:
+    h = hashlib.sha256()
+    for path in _SOURCES:
+        h.update(path.read_bytes())
+    return h.hexdigest()[:16]
+
+
+def _tag(zfl: tuple[bool, bool]) -> str:
+    return "".join("T" if z else "F" for z in zfl)
+
+
+def _write(path: Path, text: str) -> None:
+    atomic_write_text(path, text)
+
+
+@cache
+def parametric_system(zfl: tuple[bool, bool]) -> ParametricSystem:
+    """The structure's equations as numbers (from the disk cache, or derived with sympy)."""
+    path = cache_root() / "equations" / f"system-{_source_hash()}-{_tag(zfl)}.json"
+    if path.is_file():
+        try:
+            return ParametricSystem.from_json(json.loads(path.read_text()))
+        except (ValueError, KeyError):
+            pass  # damaged: derive again
+    from .equations import derive_parametric
+
+    ps = derive_parametric(zfl)
+    _write(path, json.dumps(ps.to_json()))
+    return ps
+
+
+def polynomial_system(params: Params) -> PolySystem:
+    """The equations with the parameter values substituted."""
+    ps = parametric_system(params.zfl)
+    return ps.instantiate([getattr(params, n) for n in ps.parameters])
+
+
+@cache
+def _generated():
+    path = cache_root() / "equations" / f"numeric-{_source_hash()}.py"
+    if not path.is_file():
+        from .equations import generated_source
+
+        _write(path, generated_source())
+    spec = importlib.util.spec_from_file_location(f"cotm_numeric_{_source_hash()}", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _broadcast(value, shape: tuple[int, ...]) -> np.ndarray:
+    # Generated code returns a bare scalar for a constant entry; give it the angles' shape.
+    return np.broadcast_to(np.asarray(value, dtype=float), shape)
+
+
+def _values(params: Params) -> list[float]:
+    return list(params.as_dict().values())
+
+
+def energy(params: Params, g1, g2) -> np.ndarray:
+    """Potential energy V at angles (radians)."""
+    g1, g2 = np.broadcast_arrays(np.asarray(g1, float), np.asarray(g2, float))
+    return _broadcast(_generated().energy(g1, g2, *_values(params)), g1.shape)
+
+
+def energy_gradient(params: Params, g1, g2) -> np.ndarray:
+    """Gradient of V, shape (..., 2)."""
+    g1, g2 = np.broadcast_arrays(np.atleast_1d(np.asarray(g1, float)), np.atleast_1d(g2))
+    vals = _generated().gradient(g1, g2, *_values(params))
+    return np.stack([_broadcast(v, g1.shape) for v in vals], axis=-1)
+
+
+def energy_hessian(params: Params, g1, g2) -> np.ndarray:
+    """Hessian of V, shape (..., 2, 2)."""
+    g1, g2 = np.broadcast_arrays(np.atleast_1d(np.asarray(g1, float)), np.atleast_1d(g2))
+    vals = _generated().hessian(g1, g2, *_values(params))
+    flat = [_broadcast(v, g1.shape) for row in vals for v in row]
+    return np.stack(flat, axis=-1).reshape(*g1.shape, 2, 2)
+
+
+def tan_half_jacobian(params: Params, point: tuple[complex, ...]) -> np.ndarray:
+    """Jacobian of the paper's equations (F, tau, C1, C2) in (x1, x2, d1, d2) at one point."""
+    fn = getattr(_generated(), f"tan_half_jacobian_{_tag(params.zfl)}")
+    return np.array(fn(*point, *_values(params)), dtype=complex)

@@ -1,0 +1,173 @@
+"""One parameter set solved end to end: the single path behind solve, sweeps and event refinement.
+
+equations (cached numeric form) -> engine (in-process parameter homotopy, or a Bertini binary in a
+run folder) -> endpoint table -> classified solutions, with path accounting and the Morse check.
+"""
+
+from __future__ import annotations
+
+import tempfile
+import time
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pandas as pd
+
+from .analysis.classify import classify
+from .analysis.morse import morse_check
+from .backends.endpoints import Endpoints
+from .model.compiled import parametric_system
+from .params import Params
+from .settings import Settings, Tolerances
+
+STATUS_OK = "ok"
+STATUS_INCOMPLETE = "incomplete"
+
+
+@dataclass
+class Timings:
+    """Wall-clock seconds per stage."""
+
+    stages: dict[str, float] = field(default_factory=dict)
+
+    @contextmanager
+    def stage(self, name: str):
+        start = time.perf_counter()
+        try:
+            yield
+        finally:
+            self.stages[name] = self.stages.get(name, 0.0) + time.perf_counter() - start
+
+
+@dataclass(frozen=True)
+class PointSolution:
+    """The classified solutions of one parameter set and everything that produced them."""
+
+    params: Params
+    settings: Settings
+    table: pd.DataFrame  # the solutions.csv columns
+    endpoints: Endpoints
+    counts: dict
+    morse: dict
+    status: str  # "ok", or "incomplete" when a completeness check failed
+    warnings: tuple[str, ...]
+    engine: dict  # flavour, path, version
+    system: dict  # variables, functions, degrees, total degree
+    details: dict  # engine specifics: homotopy report and generic set, or the cli attempts
+    input_text: str
+    timings: dict
+
+
+def path_counts(
+    endpoints: Endpoints, table: pd.DataFrame, paths_tracked: int | None, lost: int | None
+) -> dict:
+    """Path and solution counts; closed-form endpoints are counted apart from tracked ones."""
+    tracked_ends = endpoints.tracked
+    other = None if paths_tracked is None else paths_tracked - tracked_ends
+    return {
+        "paths_tracked": paths_tracked,
+        "finite_endpoints": tracked_ends,
+        "closed_form_endpoints": len(endpoints) - tracked_ends,
+        "infinite_or_failed_paths": other,
+        "lost_paths": lost,
+        "distinct_solutions": len(table),
+        "real": int(table["is_real"].sum()),
+        "physical": int(table["physical"].sum()),
+        "stable": int(table["stable"].sum()),
+        "zero_length_artefacts": int((table["reason"] == "zero_length_spring").sum()),
+        "negative_d": int((table["reason"] == "negative_d").sum()),
+        "singular": int(table["singular"].sum()),
+    }
+
+
+def _checks(morse: dict, counts: dict) -> tuple[str, tuple[str, ...]]:
+    """The status and the warnings of a solve: complete, or why equilibria may be missing."""
+    warnings = []
+    if not morse["ok"]:
+        text = (
+            f"#min - #saddle + #max (+ zero-length maxima) = {morse['euler_characteristic']}"
+            " != 0 on the torus"
+        )
+        if morse["degenerate"]:
+            text += f", {morse['degenerate']} degenerate"
+        warnings.append(text + ": equilibria may be missing")
+    if counts.get("lost_paths"):
+        warnings.append(f"{counts['lost_paths']} paths lost: solutions may be missing")
+    return (STATUS_INCOMPLETE if warnings else STATUS_OK), tuple(warnings)
+
+
+def solve_point(
+    params: Params,
+    settings: Settings = Settings(),
+    tolerances: Tolerances = Tolerances(),
+    folder: Path | None = None,
+    title: str = "",
+) -> PointSolution:
+    """Every finite solution of `params`, classified, with the counts and the Morse check.
+
+    The `cli` engine runs Bertini in `folder` (which must be empty; a temporary one when None)
+    and leaves its files there; the homotopy engine writes nothing.
+    """
+    t = Timings()
+    with t.stage("derive"):
+        ps = parametric_system(params.zfl)
+        system = ps.instantiate([getattr(params, n) for n in ps.parameters])
+    if settings.engine == "homotopy":
+        solved = _homotopy(params, settings, ps, t)
+    elif folder is None:
+        with tempfile.TemporaryDirectory(prefix="cotm-") as tmp:
+            solved = _cli(params, settings, system, Path(tmp) / "run", title, t)
+    else:
+        solved = _cli(params, settings, system, Path(folder), title, t)
+    endpoints, tracked, lost, engine, details, text = solved
+    with t.stage("classify"):
+        table = classify(params, endpoints, tolerances)
+        morse = morse_check(params, table)
+    counts = path_counts(endpoints, table, tracked, lost)
+    status, warnings = _checks(morse, counts)
+    shape = {
+        "variables": list(system.variables),
+        "functions": list(system.names),
+        "degrees": list(system.degrees),
+        "total_degree": system.total_degree,
+    }
+    return PointSolution(
+        params, settings, table, endpoints, counts, morse, status, warnings, engine, shape,
+        details, text, t.stages,
+    )  # fmt: skip
+
+
+def _homotopy(params: Params, settings: Settings, ps, t: Timings) -> tuple:
+    from .backends.homotopy import solve_target
+
+    with t.stage("solve"):
+        hs = solve_target(ps, params, settings)
+    engine = {
+        "flavour": "homotopy",
+        "path": "bertini module (in-process)",
+        "version": hs.generic.bertini_version,
+    }
+    details = {"homotopy": hs.info, "generic_set": hs.generic.summary()}
+    return hs.endpoints, hs.info["tracked"], hs.info["lost"], engine, details, hs.input_text
+
+
+def _cli(params: Params, settings: Settings, system, folder: Path, title: str, t: Timings):
+    from .backends.bertini_cli import solve_cli
+
+    with t.stage("solve"):
+        cs = solve_cli(system, settings, folder, params.as_dict(), title)
+    t.stages.update(cs.timings)
+    run = cs.run
+    engine = {"flavour": run.engine.flavour, "path": run.engine.path, "version": run.version}
+    details = {
+        "output_layout": cs.output.layout,
+        "bertini_seconds": cs.run.seconds,
+        "bertini1_failed_paths_file": cs.output.failed_paths,
+    }
+    if cs.attempts:
+        details["attempts"] = cs.attempts
+    out = cs.output
+    # Bertini 1 lists failed paths; those truncated on their way to infinity are not lost.
+    lost = None if out.failed_paths is None else out.failed_paths - (out.truncated_infinite or 0)
+    return cs.endpoints, cs.paths_tracked, lost, engine, details, cs.input_text

@@ -20,12 +20,17 @@ def cache_root() -> Path:
 
 def atomic_write_text(path: Path, text: str) -> None:
     """Write text to path via a temporary file in the same folder and an atomic rename."""
+    atomic_write_bytes(path, text.encode())
+
+
+def atomic_write_bytes(path: Path, data: bytes) -> None:
+    """Write bytes to path via a temporary file in the same folder and an atomic rename."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
-        with os.fdopen(fd, "w") as fh:
-            fh.write(text)
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
             fh.flush()
             os.fsync(fh.fileno())
         os.replace(tmp, path)
@@ -37,6 +42,28 @@ def atomic_write_text(path: Path, text: str) -> None:
 def write_csv(path: Path, frame) -> None:
     """A CSV that loads straight into pandas or a spreadsheet, written atomically."""
     atomic_write_text(path, frame.to_csv(index=False))
+
+
+def _cell(value) -> str:
+    # As pandas writes them: shortest round-trip floats, NaN empty, True/False.
+    if isinstance(value, float):
+        return "" if value != value else repr(value)
+    return str(value)
+
+
+def columns_csv(columns: dict) -> str:
+    """CSV text of a table given as columns (sequences of equal length), as pandas writes it."""
+    import csv
+    import io
+
+    names = list(columns)
+    lists = [columns[n].tolist() if hasattr(columns[n], "tolist") else columns[n] for n in names]
+    rows = zip(*lists, strict=True)
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\n")
+    writer.writerow(names)
+    writer.writerows([_cell(v) for v in row] for row in rows)
+    return out.getvalue()
 
 
 def write_json(path: Path, data: dict) -> None:

@@ -10,11 +10,12 @@ import tempfile
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 
-import pandas as pd
+import numpy as np
 
-from .analysis.classify import classify
+from .analysis.classify import classify_columns
 from .analysis.morse import morse_check
 from .backends.endpoints import Endpoints
 from .model.compiled import parametric_system
@@ -46,7 +47,7 @@ class PointSolution:
 
     params: Params
     settings: Settings
-    table: pd.DataFrame  # the solutions.csv columns
+    columns: dict[str, np.ndarray]  # the solutions.csv columns, as numpy arrays
     endpoints: Endpoints
     counts: dict
     morse: dict
@@ -57,10 +58,18 @@ class PointSolution:
     details: dict  # engine specifics: homotopy report and generic set, or the cli attempts
     input_text: str
     timings: dict
+    warm: object = None  # homotopy engine: this point as a start for a neighbouring one
+
+    @cached_property
+    def table(self):
+        """The solutions as a pandas DataFrame (built on first use: pandas loads only then)."""
+        import pandas as pd
+
+        return pd.DataFrame(self.columns)
 
 
 def path_counts(
-    endpoints: Endpoints, table: pd.DataFrame, paths_tracked: int | None, lost: int | None
+    endpoints: Endpoints, table: dict, paths_tracked: int | None, lost: int | None
 ) -> dict:
     """Path and solution counts; closed-form endpoints are counted apart from tracked ones."""
     tracked_ends = endpoints.tracked
@@ -71,7 +80,7 @@ def path_counts(
         "closed_form_endpoints": len(endpoints) - tracked_ends,
         "infinite_or_failed_paths": other,
         "lost_paths": lost,
-        "distinct_solutions": len(table),
+        "distinct_solutions": len(table["solution_id"]),
         "real": int(table["is_real"].sum()),
         "physical": int(table["physical"].sum()),
         "stable": int(table["stable"].sum()),
@@ -103,26 +112,28 @@ def solve_point(
     tolerances: Tolerances = Tolerances(),
     folder: Path | None = None,
     title: str = "",
+    warm=None,
 ) -> PointSolution:
     """Every finite solution of `params`, classified, with the counts and the Morse check.
 
     The `cli` engine runs Bertini in `folder` (which must be empty; a temporary one when None)
-    and leaves its files there; the homotopy engine writes nothing.
+    and leaves its files there; the homotopy engine writes nothing. `warm` (the `warm` of a
+    neighbouring point's solution) lets the homotopy engine continue from that point.
     """
     t = Timings()
     with t.stage("derive"):
         ps = parametric_system(params.zfl)
         system = ps.instantiate([getattr(params, n) for n in ps.parameters])
     if settings.engine == "homotopy":
-        solved = _homotopy(params, settings, ps, t)
+        solved = _homotopy(params, settings, ps, t, warm)
     elif folder is None:
         with tempfile.TemporaryDirectory(prefix="cotm-") as tmp:
             solved = _cli(params, settings, system, Path(tmp) / "run", title, t)
     else:
         solved = _cli(params, settings, system, Path(folder), title, t)
-    endpoints, tracked, lost, engine, details, text = solved
+    endpoints, tracked, lost, engine, details, text, warm_next = solved
     with t.stage("classify"):
-        table = classify(params, endpoints, tolerances)
+        table = classify_columns(params, endpoints, tolerances)
         morse = morse_check(params, table)
     counts = path_counts(endpoints, table, tracked, lost)
     status, warnings = _checks(morse, counts)
@@ -134,22 +145,23 @@ def solve_point(
     }
     return PointSolution(
         params, settings, table, endpoints, counts, morse, status, warnings, engine, shape,
-        details, text, t.stages,
+        details, text, t.stages, warm_next,
     )  # fmt: skip
 
 
-def _homotopy(params: Params, settings: Settings, ps, t: Timings) -> tuple:
+def _homotopy(params: Params, settings: Settings, ps, t: Timings, warm) -> tuple:
     from .backends.homotopy import solve_target
 
     with t.stage("solve"):
-        hs = solve_target(ps, params, settings)
+        hs = solve_target(ps, params, settings, warm)
     engine = {
         "flavour": "homotopy",
         "path": "bertini module (in-process)",
         "version": hs.generic.bertini_version,
     }
     details = {"homotopy": hs.info, "generic_set": hs.generic.summary()}
-    return hs.endpoints, hs.info["tracked"], hs.info["lost"], engine, details, hs.input_text
+    info = hs.info
+    return hs.endpoints, info["tracked"], info["lost"], engine, details, hs.input_text, hs.warm
 
 
 def _cli(params: Params, settings: Settings, system, folder: Path, title: str, t: Timings):
@@ -170,4 +182,4 @@ def _cli(params: Params, settings: Settings, system, folder: Path, title: str, t
     out = cs.output
     # Bertini 1 lists failed paths; those truncated on their way to infinity are not lost.
     lost = None if out.failed_paths is None else out.failed_paths - (out.truncated_infinite or 0)
-    return cs.endpoints, cs.paths_tracked, lost, engine, details, cs.input_text
+    return cs.endpoints, cs.paths_tracked, lost, engine, details, cs.input_text, None

@@ -72,7 +72,13 @@ def test_dask_cluster_gives_the_same_rows(sweep21, tmp_path):
     dask_rows = assemble(sub, folder_sub)
     local = assemble(spec0, folder0)
     local = local[local["point"] < 6].reset_index(drop=True)
-    pd.testing.assert_frame_equal(dask_rows, local, check_exact=False, rtol=1e-9)
+    # The route to a point (its first one of a run is solved from the generic set, the others
+    # continued from their neighbour) depends on how the points were cut into runs: compare the
+    # solutions, not the `method` column.
+    pd.testing.assert_frame_equal(
+        dask_rows.drop(columns="method"), local.drop(columns="method"), check_exact=False,
+        rtol=1e-9,
+    )  # fmt: skip
 
 
 def _cli(*args: str, **kw):
@@ -126,7 +132,11 @@ def test_resume_after_kill_9(tmp_path):
     a = pd.read_csv(folder / "sweep.csv")
     b = pd.read_csv(next((tmp_path / "b").glob("sweep-*")) / "sweep.csv")
     assert len(a) == len(b) and not a.duplicated(["point", "solution_id"]).any()
-    pd.testing.assert_frame_equal(a, b)
+    # The resumed run solves its first point from the generic set, the uninterrupted one
+    # continues it from its neighbour: same solutions, another `method`.
+    pd.testing.assert_frame_equal(
+        a.drop(columns="method"), b.drop(columns="method"), check_exact=False, rtol=1e-9
+    )
 
 
 def test_bad_sweep_requests():

@@ -5,15 +5,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import pandas as pd
 
 from ..backends.endpoints import Endpoints
 from ..model.compiled import polynomial_system
 from ..model.kinematics import spring_vectors
+from ..model.polynomial import PolySystem
 from ..params import Params
 from ..settings import Tolerances
 from .cluster import cluster_endpoints
-from .mechanics import add_mechanics, paper_criterion
+from .mechanics import mechanics, paper_criterion
 from .refine import newton_refine, snap_zero_length
 
 COLUMNS = [
@@ -73,9 +73,8 @@ class _Merged:
     accuracy: np.ndarray
 
 
-def _merge(params: Params, endpoints: Endpoints, tol: Tolerances) -> _Merged:
+def _merge(params: Params, system: PolySystem, endpoints: Endpoints, tol: Tolerances) -> _Merged:
     """Snap, Newton-refine and cluster the endpoints into distinct solutions."""
-    system = polynomial_system(params.normalized())
     is_d = np.array([v.startswith("d") for v in endpoints.variables])
     x0 = np.where(is_d, endpoints.points / params.L3, endpoints.points)
     acc = np.nan_to_num(endpoints.accuracy_estimate, nan=0.0)
@@ -100,18 +99,26 @@ def _merge(params: Params, endpoints: Endpoints, tol: Tolerances) -> _Merged:
     )
 
 
-def classify(params: Params, endpoints: Endpoints, tol: Tolerances = Tolerances()) -> pd.DataFrame:
-    """One row per distinct finite solution with the solutions.csv columns (docs/columns.md).
+def classify(params: Params, endpoints: Endpoints, tol: Tolerances = Tolerances()):
+    """One row per distinct finite solution with the solutions.csv columns (a DataFrame)."""
+    import pandas as pd  # only here: the solve path works on numpy columns
+
+    return pd.DataFrame(classify_columns(params, endpoints, tol))
+
+
+def classify_columns(
+    params: Params, endpoints: Endpoints, tol: Tolerances = Tolerances()
+) -> dict[str, np.ndarray]:
+    """The solutions table as numpy columns (COLUMNS, then `<var>_re`, `<var>_im`), ordered.
 
     The numerics (Newton refinement, condition numbers, merging, realness) run in units of L3
     and max(k1, k2), where every quantity is of order one whatever the user's units.
     """
     variables = endpoints.variables
-    merged = _merge(params, endpoints, tol)
-    if not len(merged.x):
-        return empty_solutions(variables)
     system = polynomial_system(params.normalized())
-    absres = np.abs(system.evaluate(merged.x)).max(axis=1)
+    merged = _merge(params, system, endpoints, tol)
+    if not len(merged.x):
+        return empty_columns(variables)
     is_d = np.array([v.startswith("d") for v in variables])
     pts = np.where(is_d, merged.x * params.L3, merged.x)
     v = {name: pts[:, k] for k, name in enumerate(variables)}
@@ -124,77 +131,84 @@ def classify(params: Params, endpoints: Endpoints, tol: Tolerances = Tolerances(
     g1r, g2r = np.radians(gam1.real), np.radians(gam2.real)
     vec = spring_vectors(params, np.cos(g1r), np.sin(g1r), np.cos(g2r), np.sin(g2r))
     d = {i: v[f"d{i}"].real if f"d{i}" in v else np.hypot(*vec[f"spring{i}"]) for i in (1, 2)}
-    frame = pd.DataFrame(
-        {
-            "solution_id": np.arange(1, len(pts) + 1),
-            "gamma1_deg": wrap_degrees(gam1.real),
-            "gamma2_deg": wrap_degrees(gam2.real),
-            "gamma1_imag_deg": gam1.imag,
-            "gamma2_imag_deg": gam2.imag,
-            "d1": d[1],
-            "d2": d[2],
-            "is_real": is_real,
-            "max_imag": max_imag,
-        }
-    )
-    _physical_columns(frame, params, v, d, is_real, tol)
-    frame["residual"] = absres
-    frame["condition_number"] = merged.condition_number
-    frame["jacobian_condition"] = merged.jacobian_condition
-    frame["multiplicity"] = merged.multiplicity
-    frame["singular"] = merged.singular
-    physical = frame["physical"].to_numpy()
-    add_mechanics(frame, params, g1r, g2r, vec, physical & ~merged.singular, tol.hessian)
-    frame["paper_stable"] = paper_criterion(params, frame)
-    frame["paths"] = merged.paths
+    cols: dict[str, np.ndarray] = {
+        "solution_id": np.arange(1, len(pts) + 1),
+        "gamma1_deg": wrap_degrees(gam1.real),
+        "gamma2_deg": wrap_degrees(gam2.real),
+        "d1": d[1],
+        "d2": d[2],
+        "is_real": is_real,
+        "max_imag": max_imag,
+        "residual": np.abs(system.evaluate(merged.x)).max(axis=1),
+        "condition_number": merged.condition_number,
+        "multiplicity": merged.multiplicity,
+        "singular": merged.singular,
+        "jacobian_condition": merged.jacobian_condition,
+        "gamma1_imag_deg": gam1.imag,
+        "gamma2_imag_deg": gam2.imag,
+        "paths": np.array(merged.paths, dtype=object),
+    }
+    cols.update(_physical_columns(params, v, d, is_real, tol))
+    stable_ok = cols["physical"] & ~merged.singular
+    cols.update(mechanics(params, cols["physical"], g1r, g2r, vec, stable_ok, tol.hessian))
+    cols["paper_stable"] = paper_criterion(params, cols)
     for name in variables:
-        frame[f"{name}_re"] = v[name].real
-        frame[f"{name}_im"] = v[name].imag
-    return _order(frame)
+        cols[f"{name}_re"] = v[name].real
+        cols[f"{name}_im"] = v[name].imag
+    return _order(cols, variables)
 
 
-def _physical_columns(frame, params, v, d, is_real, tol: Tolerances) -> None:
+def _physical_columns(params, v, d, is_real, tol: Tolerances) -> dict[str, np.ndarray]:
     """`reason` and `physical`: real, both spring lengths > 0, not a d = 0 artefact."""
-    zero = np.zeros(len(frame), dtype=bool)
+    zero = np.zeros(len(is_real), dtype=bool)
     for i in (1, 2):
         if f"d{i}" in v:
             # d = 0 with L0 > 0 is never an equilibrium (the force direction is undefined):
             # the double roots where one spring collapses, and the complex points where both do.
             zero |= np.abs(v[f"d{i}"]) < tol.zero_length * params.L3
     negative = is_real & ((d[1] <= 0) | (d[2] <= 0)) & ~zero
-    frame["reason"] = np.select(
+    reason = np.select(
         [zero, ~is_real, negative], ["zero_length_spring", "complex", "negative_d"], default=""
     )
-    frame["physical"] = is_real & ~zero & ~negative
+    return {"reason": reason.astype(object), "physical": is_real & ~zero & ~negative}
 
 
-def _order(frame: pd.DataFrame) -> pd.DataFrame:
+def _order(cols: dict[str, np.ndarray], variables: tuple[str, ...]) -> dict[str, np.ndarray]:
     # Physical first, then real, then complex; within each by angle, so ids are stable. Angles
     # are rounded to 1e-9 deg so that a conjugate pair (equal real parts up to rounding) is
     # always ordered by its imaginary part, whichever run produced it.
-    key = np.where(frame["physical"], 0, np.where(frame["is_real"], 1, 2))
-    sort = frame.assign(
-        _k=key,
-        _g1=wrap_degrees(frame["gamma1_deg"].to_numpy(), 9),
-        _g2=wrap_degrees(frame["gamma2_deg"].to_numpy(), 9),
-        _i1=np.round(frame["gamma1_imag_deg"].to_numpy(), 9),
-        _i2=np.round(frame["gamma2_imag_deg"].to_numpy(), 9),
+    group = np.where(cols["physical"], 0, np.where(cols["is_real"], 1, 2))
+    keys = (
+        np.round(cols["gamma2_imag_deg"], 9),
+        np.round(cols["gamma1_imag_deg"], 9),
+        wrap_degrees(cols["gamma2_deg"], 9),
+        wrap_degrees(cols["gamma1_deg"], 9),
+        group,
     )
-    cols = ["_k", "_g1", "_g2", "_i1", "_i2"]
-    frame = sort.sort_values(cols, kind="stable").drop(columns=cols).reset_index(drop=True)
-    frame["solution_id"] = np.arange(1, len(frame) + 1)
-    rest = [c for c in frame.columns if c not in COLUMNS]
-    return frame[COLUMNS + rest]
+    order = np.lexsort(keys)  # the last key is the primary one
+    names = COLUMNS + [f"{n}_{p}" for n in variables for p in ("re", "im")]
+    out = {name: cols[name][order] for name in names}
+    out["solution_id"] = np.arange(1, len(order) + 1)
+    return out
 
 
-def empty_solutions(variables: tuple[str, ...]) -> pd.DataFrame:
+def empty_columns(variables: tuple[str, ...]) -> dict[str, np.ndarray]:
     """A solutions table with no rows (every column present)."""
     cols = COLUMNS + [f"{n}_{p}" for n in variables for p in ("re", "im")]
-    return pd.DataFrame({c: pd.Series(dtype=float) for c in cols})
+    return {c: np.zeros(0, dtype=float) for c in cols}
 
 
-def read_table(path) -> pd.DataFrame:
+def empty_solutions(variables: tuple[str, ...]):
+    """A solutions table with no rows (every column present), as a DataFrame."""
+    import pandas as pd
+
+    return pd.DataFrame(empty_columns(variables))
+
+
+def read_table(path):
     """A solutions (or sweep) table read back from CSV with the dtypes a fresh solve gives."""
+    import pandas as pd
+
     table = pd.read_csv(path)
     for col in ("reason", "kind"):
         table[col] = table[col].fillna("").astype(str)

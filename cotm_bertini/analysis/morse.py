@@ -8,7 +8,6 @@ equilibrium is missing. Where a spring with L0 > 0 can reach zero length, V has 
 from __future__ import annotations
 
 import numpy as np
-import pandas as pd
 
 from ..model.kinematics import spring_jacobian, spring_vectors, zero_length_poses
 from ..params import Params
@@ -59,14 +58,14 @@ def zero_length_configurations(params: Params) -> list[dict]:
     return found
 
 
-def morse_check(params: Params, frame: pd.DataFrame) -> dict:
+def morse_check(params: Params, table) -> dict:
     """#min - #saddle + #max over the physical equilibria, zero-length cusps counted as maxima.
 
     The torus has Euler characteristic 0, so a non-zero total means equilibria are missing (or a
-    degenerate one makes the count inapplicable).
+    degenerate one makes the count inapplicable). `table`: a DataFrame or a dict of columns.
     """
-    phys = frame[frame["physical"].astype(bool)]
-    counts = {k: int((phys["kind"] == k).sum()) for k in ("min", "saddle", "max", "degenerate")}
+    kinds = np.asarray(table["kind"], dtype=object)[np.asarray(table["physical"], dtype=bool)]
+    counts = {k: int((kinds == k).sum()) for k in ("min", "saddle", "max", "degenerate")}
     cusps = sum(c["is_max"] for c in zero_length_configurations(params))
     total = counts["min"] - counts["saddle"] + counts["max"] + cusps
     ok = total == 0 and counts["degenerate"] == 0

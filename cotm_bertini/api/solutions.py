@@ -34,12 +34,15 @@ class Solutions:
     folder the command line writes.
     """
 
-    def __init__(self, params: Params, settings: Settings, record: dict, folder: Path, table=None):
+    def __init__(
+        self, params: Params, settings: Settings, record: dict, folder: Path, columns=None
+    ):
         self.params = params
         self.settings = settings
         self.record = record
         self.folder = Path(folder)  # holds solutions.csv, run.json, input and solver files
-        self._table = table
+        self._columns = columns  # a fresh solve's numpy columns (the table is built from them)
+        self._table = None
 
     def __repr__(self) -> str:
         c = self.counts
@@ -52,7 +55,12 @@ class Solutions:
     def table(self):
         """Every distinct finite solution (pandas DataFrame, the solutions.csv columns)."""
         if self._table is None:
-            self._table = read_solutions(self.folder)
+            if self._columns is not None:
+                import pandas as pd
+
+                self._table = pd.DataFrame(self._columns)
+            else:
+                self._table = read_solutions(self.folder)
         return self._table
 
     @property
@@ -176,7 +184,7 @@ def solve(
         folder = solve_cache.commit(key, work)
     else:
         folder = work
-    result = Solutions(params, settings, record, folder, point.table)
+    result = Solutions(params, settings, record, folder, point.columns)
     if not cache:
         weakref.finalize(result, shutil.rmtree, str(work), True)
     return result

@@ -119,7 +119,7 @@ def _run(spec, folder: Path, workers: int, scheduler, progress, command) -> Swee
     from ..continuation.results import finish
     from ..continuation.runner import pending_points, run_points
 
-    bar, callback = _progress(progress, len(spec.grid()), len(pending_points(spec, folder)))
+    bar, callback = _progress(progress, spec.size(), len(pending_points(spec, folder)))
     try:
         stats = run_points(spec, folder, workers=workers, scheduler=scheduler, progress=callback)
     finally:

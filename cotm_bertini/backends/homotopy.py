@@ -27,7 +27,7 @@ from ..params import Params
 from ..settings import Settings
 from ..versions import bertini2_version
 from .endpoints import Endpoints
-from .render import render_parameter_homotopy, render_system
+from .render import parametric_texts, render_parameter_homotopy, render_system
 
 _SUCCESS = "Success"
 DOUBLE_FINAL_TOLERANCE = 1e-8
@@ -108,17 +108,43 @@ class GenericSet:
         }
 
 
+# The generic start: the paper's case 3 in normalised units, plus a random complex perturbation
+# of this size in every parameter. Random complex, so the straight line to any real target misses
+# the parameters where paths meet (with probability one); centred on the real parameters users
+# ask about, so the paths are short: 2.5 times fewer steps than a start centred at 0 (measured on
+# case 3 and random geometries; bench/homotopy_start.py).
+START_CENTRE = {
+    "L3": 1.0, "k1": 1.0, "k2": 1.0, "p2x": 0.3541666666666667, "p3x": -0.28605555555555556,
+    "p3y": 0.5478777777777778, "p6x": 0.4722222222222222, "p5x": -0.03322222222222222,
+    "p5y": -0.3874666666666667, "L01": 1.2777777777777777, "L02": 1.2777777777777777,
+}  # fmt: skip
+START_SPREAD = 0.5
+
+
 def generic_key(ps: ParametricSystem, seed: int) -> str:
-    """Content hash of what a generic set depends on: equations, seed, engine version."""
+    """Content hash of what a generic set depends on: equations, seed, start, engine version."""
+    start = {"centre": START_CENTRE, "spread": START_SPREAD}
     blob = json.dumps(
-        {"system": ps.to_json(), "seed": seed, "bertini2": bertini2_version(), "scale": {}},
+        {"system": ps.to_json(), "seed": seed, "bertini2": bertini2_version(), "start": start},
         sort_keys=True,
     )
     return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
 
+_LOADED: dict[tuple[int, int], GenericSet] = {}
+
+
 def generic_set(ps: ParametricSystem, seed: int = 1, use_cache: bool = True) -> GenericSet:
-    """The generic solution set of `ps` for `seed`, from the disk cache or solved ab initio."""
+    """The generic solution set of `ps` for `seed`, from memory, the disk cache, or solved."""
+    if use_cache and (id(ps), seed) in _LOADED:  # ps objects live as long as the process
+        return _LOADED[id(ps), seed]
+    gs = _load_or_solve(ps, seed, use_cache)
+    if use_cache:
+        _LOADED[id(ps), seed] = gs
+    return gs
+
+
+def _load_or_solve(ps: ParametricSystem, seed: int, use_cache: bool) -> GenericSet:
     key = generic_key(ps, seed)
     path = cache_root() / f"generic-{key}.json"
     if use_cache and path.is_file():
@@ -137,8 +163,10 @@ def _solve_generic(ps: ParametricSystem, seed: int, key: str) -> GenericSet:
     from bertini import nag_algorithm as na
 
     rng = np.random.default_rng(seed)
-    # Targets are normalised (Params.normalized): every parameter is of order one, and so is p0.
-    start = {name: complex(*rng.normal(size=2)) / np.sqrt(2) for name in ps.parameters}
+    start = {
+        name: START_CENTRE[name] + START_SPREAD * complex(*rng.normal(size=2)) / np.sqrt(2)
+        for name in ps.parameters
+    }
     system = ps.instantiate([start[n] for n in ps.parameters])
     bertini.random.set_random_seed(seed)
     t0 = time.perf_counter()
@@ -333,6 +361,16 @@ def zero_length_roots(params: Params, variables: tuple[str, ...]) -> Endpoints:
     return Endpoints.from_records(variables, records)
 
 
+@dataclass(frozen=True, eq=False)
+class WarmStart:
+    """A real parameter set with its complete set of nonsingular finite solutions (as many as
+    the generic set has, in normalised units): a start for the next point of a sweep."""
+
+    params: Params
+    points: np.ndarray
+    generic_key: str
+
+
 @dataclass(frozen=True)
 class HomotopySolve:
     """Every finite endpoint at a target and how the homotopy got there."""
@@ -341,17 +379,24 @@ class HomotopySolve:
     info: dict
     generic: GenericSet
     input_text: str
+    warm: WarmStart | None = None  # this target as a start for a neighbouring one
 
 
 def solve_target(
-    ps: ParametricSystem, params: Params, settings: Settings = Settings()
+    ps: ParametricSystem,
+    params: Params,
+    settings: Settings = Settings(),
+    warm: WarmStart | None = None,
 ) -> HomotopySolve:
     """Every finite endpoint at `params` (tracked ones plus the closed-form d = 0 artefacts).
 
-    Parameter homotopy from the cached generic set. If a path is lost, or fewer finite endpoints
-    arrive than the generic count, the point is tracked again from a second, independent generic
+    With `warm` (a neighbouring real point of the same structure, solved completely), its
+    solutions are continued to `params` (see `continue_from`); if that fails a check, the point
+    is solved from the generic set as without it. From the generic set: a lost path, or fewer
+    finite endpoints than the generic count, sends the point to a second, independent generic
     set (a new random start, like Paramotopy's new gamma); if that does not settle it, the target
-    is solved ab initio. `info["method"]` says which, `info["lost"]` how many paths were lost.
+    is solved ab initio. `info["method"]` says which route, `info["lost"]` how many paths were
+    lost.
 
     The target is solved in units of L3 and max(k1, k2) (equilibria do not change when every
     length, or every stiffness, is scaled), so the paths see numbers of order one whatever the
@@ -360,7 +405,31 @@ def solve_target(
     deadline = None if settings.timeout is None else time.perf_counter() + settings.timeout
     gs = generic_set(ps, settings.seed)
     unit = params.normalized()
-    target = {n: getattr(unit, n) for n in ps.parameters}
+    result, note = None, ""
+    if warm is not None:
+        result, note = continue_from(ps, gs, warm, params, settings, deadline)
+    if result is None:
+        result = _from_generic(ps, gs, unit, settings, deadline)
+        if note:
+            result[1]["method"] += f" ({note})"
+    endpoints, info, text = result
+    complete = info["lost"] == 0 and info["finite"] == len(gs.points)
+    warm_next = WarmStart(params, endpoints.points, gs.key) if complete else None
+    is_d = np.array([v.startswith("d") for v in ps.variables])
+    scaled = np.where(is_d, endpoints.points * params.L3, endpoints.points)
+    endpoints = endpoints.with_points(scaled)
+    info.update(
+        units={"length": params.L3, "stiffness": max(params.k1, params.k2)},
+        generic_key=gs.key,
+        generic_paths=gs.paths,
+        generic_finite=gs.finite_endpoints,
+    )
+    closed = zero_length_roots(params, ps.variables)
+    return HomotopySolve(endpoints.concat(closed), info, gs, text, warm_next)
+
+
+def _from_generic(ps, gs: GenericSet, unit: Params, settings: Settings, deadline) -> tuple:
+    """Track the generic set to the (normalised) target, with the fallbacks of solve_target."""
     endpoints, rep = track(ps, gs, unit, settings, deadline)
     method = "parameter homotopy" + (" + adaptive retrack" if rep.retracked_adaptive else "")
     if rep.lost or rep.finite < len(gs.points):
@@ -372,29 +441,21 @@ def solve_target(
             endpoints, rep = endpoints2, rep2
             method = "parameter homotopy from a second start (the first lost paths)"
         else:
-            endpoints = ab_initio(ps, unit, settings)
+            endpoints, lost = ab_initio(ps, unit, settings)
+            rep.finite, rep.lost = len(endpoints), lost
             method = "ab initio (both parameter homotopies lost paths)"
-    is_d = np.array([v.startswith("d") for v in ps.variables])
-    endpoints = endpoints.with_points(
-        np.where(is_d, endpoints.points * params.L3, endpoints.points)
-    )
-    info = {
-        **rep.as_dict(),
-        "method": method,
-        "units": {"length": params.L3, "stiffness": max(params.k1, params.k2)},
-        "generic_key": gs.key,
-        "generic_paths": gs.paths,
-        "generic_finite": gs.finite_endpoints,
-    }
-    closed = zero_length_roots(params, ps.variables)
+    target = {n: getattr(unit, n) for n in ps.parameters}
     text = render_parameter_homotopy(ps, gs.start, target)
-    return HomotopySolve(endpoints.concat(closed), info, gs, text)
+    return endpoints, {**rep.as_dict(), "method": method}, text
 
 
-def ab_initio(ps: ParametricSystem, params: Params, settings: Settings = Settings()) -> Endpoints:
+def ab_initio(
+    ps: ParametricSystem, params: Params, settings: Settings = Settings()
+) -> tuple[Endpoints, int]:
     """Total-degree solve at the target itself (in-process): the last resort.
 
-    Its singular endpoints (the d = 0 artefacts) are dropped: the closed form reports them.
+    Returns the nonsingular finite endpoints (the closed form reports the d = 0 artefacts) and
+    the number of paths that failed (neither finite nor going to infinity).
     """
     bertini = _bertini()
     from bertini import nag_algorithm as na
@@ -405,11 +466,103 @@ def ab_initio(ps: ParametricSystem, params: Params, settings: Settings = Setting
     if settings.threads is not None:
         solver.set(num_threads=settings.threads)
     solver.solve(show_progress=False)
-    rows = [
-        endpoint_record(i, m, p)
-        for i, (m, p) in enumerate(
-            zip(solver.solution_metadata(), solver.all_solutions(), strict=True)
-        )
-        if m.is_finite and _code(m) == _SUCCESS and not is_singular(m)
-    ]
-    return Endpoints.from_records(ps.variables, rows)
+    rows, lost = [], 0
+    ends = zip(solver.solution_metadata(), solver.all_solutions(), strict=True)
+    for i, (m, p) in enumerate(ends):
+        code = _code(m)
+        if m.is_finite and code == _SUCCESS:
+            if not is_singular(m):
+                rows.append(endpoint_record(i, m, p))
+        elif code not in ("GoingToInfinity", "SecurityMaxNormReached") and m.is_finite:
+            lost += 1
+    return Endpoints.from_records(ps.variables, rows), lost
+
+
+# --- continuation from a neighbouring real point ---------------------------------------------
+
+# Continuation steps: the segment between neighbouring sweep points is short, so the tracker may
+# take large steps (the checks below catch a path that jumps).
+_CONTINUATION_STEPS = {"max_step_size": "0.5", "initial_step_size": "0.5"}
+
+
+def continue_from(
+    ps: ParametricSystem,
+    gs: GenericSet,
+    warm: WarmStart,
+    params: Params,
+    settings: Settings,
+    deadline: float | None,
+) -> tuple[tuple | None, str]:
+    """The solutions at `params` continued from a neighbouring real point's complete set.
+
+    Only the parameters that differ (in normalised units) move, from the warm point (t = 1) to
+    the target (t = 0), with a random complex detour * t (1 - t) so the path misses the real
+    folds between the two points (the gamma trick of parameter homotopies). Checked: every path
+    ends finite and in success, as many as the generic count, no two at the same point (a path
+    that jumped). Returns ((endpoints, info, input text), "") or (None, why it was refused).
+    """
+    a, b = warm.params.normalized(), params.normalized()
+    if warm.generic_key != gs.key:
+        return None, "the previous point has another structure"
+    if len(warm.points) != len(gs.points):
+        return None, "the previous point's solution set is incomplete"
+    free = [n for n in ps.parameters if getattr(a, n) != getattr(b, n)]
+    if not free:
+        free = ps.parameters[:1]  # the same point: a loop through the complex plane
+    fixed = tuple((n, getattr(b, n)) for n in ps.parameters if n not in free)
+    sub, texts = _fixed_system(ps, gs.key, fixed)
+    # Reproducible: the detour depends on the seed and the target only (hash of floats is stable).
+    rng = np.random.default_rng(abs(hash((settings.seed, *(getattr(b, n) for n in free)))))
+    start = {n: getattr(a, n) for n in free}
+    target = {n: getattr(b, n) for n in free}
+    scale = {n: abs(target[n] - start[n]) or 1e-3 for n in free}
+    detour = {
+        n: scale[n] * complex(rng.uniform(-0.5, 0.5), rng.choice([-1, 1]) * rng.uniform(0.5, 1))
+        for n in free
+    }
+    text = render_parameter_homotopy(sub, start, target, detour, texts)
+    meta, pts = _run_homotopy(sub, text, warm.points, target, settings, deadline)
+    rows, failed = [], 0
+    for i, (m, p) in enumerate(zip(meta, pts, strict=True)):
+        if _code(m) == _SUCCESS and m.is_finite:
+            rows.append(endpoint_record(i, m, p))
+        else:
+            failed += 1
+    results = {i: (m, p) for i, (m, p) in enumerate(zip(meta, pts, strict=True))}
+    if failed:
+        return None, f"{failed} paths did not end in success"
+    if _crossing(results, list(results)):
+        return None, "two paths ended at the same point"
+    rep = TrackReport(tracked=len(pts), finite=len(rows), method="continued")
+    info = {**rep.as_dict(), "method": "continued from the neighbouring point", "moved": free}
+    return (Endpoints.from_records(ps.variables, rows), info, text), ""
+
+
+_FIXED: dict[tuple, tuple[ParametricSystem, tuple[str, ...]]] = {}
+
+
+def _fixed_system(ps: ParametricSystem, key: str, fixed: tuple) -> tuple:
+    """`ps` with the `fixed` parameters folded in, and its texts (kept: a sweep reuses them)."""
+    if (key, fixed) not in _FIXED:
+        if len(_FIXED) > 32:
+            _FIXED.clear()
+        sub = ps.fix(dict(fixed))
+        _FIXED[key, fixed] = (sub, parametric_texts(sub))
+    return _FIXED[key, fixed]
+
+
+def _run_homotopy(sub, text: str, points, target: dict, settings: Settings, deadline):
+    """Track `points` along the homotopy `text` in double precision with large steps."""
+    bertini = _bertini()
+    from bertini import nag_algorithm as na
+
+    system = sub.instantiate([target[n] for n in sub.parameters])
+    hom = bertini.parse.system(text)
+    tgt = bertini.parse.system(render_system(system))
+    solver = na.HomotopySolver(hom, list(points), tgt, mptype="double")
+    _configure(solver, settings, "double", deadline)
+    solver.set(**{k: bertini.multiprec.real_mp(v) for k, v in _CONTINUATION_STEPS.items()})
+    solver.solve(show_progress=False)
+    if deadline is not None and time.perf_counter() > deadline:
+        raise SolverError(f"the in-process solve timed out after {settings.timeout:g} s")
+    return solver.solution_metadata(), solver.all_solutions()

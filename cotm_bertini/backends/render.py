@@ -117,15 +117,38 @@ def render_system(system: PolySystem) -> str:
     )
 
 
+def parametric_texts(ps: ParametricSystem) -> tuple[str, ...]:
+    """Each function as text in the variables and the parameters (the derivation's texts, or,
+    for a system with parameters fixed, rendered from its terms)."""
+    if ps.texts:
+        return ps.texts
+    names = tuple(ps.variables) + tuple(ps.parameters)
+    return tuple(
+        polynomial_text(names, np.hstack([ve, pe]), c)
+        for ve, pe, c in zip(ps.var_exps, ps.par_exps, ps.coeffs, strict=True)
+    )
+
+
 def render_parameter_homotopy(
-    ps: ParametricSystem, start: dict[str, complex], target: dict[str, complex]
+    ps: ParametricSystem,
+    start: dict[str, complex],
+    target: dict[str, complex],
+    detour: dict[str, complex] | None = None,
+    texts: tuple[str, ...] | None = None,
 ) -> str:
-    """INPUT section of the homotopy moving the parameters from `start` (t=1) to `target` (t=0)."""
+    """INPUT section of the homotopy moving the parameters from `start` (t=1) to `target` (t=0),
+    on a straight line, or bulging into the complex plane by `detour` * t (1 - t)."""
     parameters = [
-        {"name": n, "start": complex_number(start[n]), "target": complex_number(target[n])}
+        {
+            "name": n,
+            "start": complex_number(start[n]),
+            "target": complex_number(target[n]),
+            "detour": complex_number(detour[n]) if detour else "",
+        }
         for n in ps.parameters
     ]
-    functions = [{"name": n, "text": t} for n, t in zip(ps.names, ps.texts, strict=True)]
+    texts = texts if texts is not None else parametric_texts(ps)
+    functions = [{"name": n, "text": t} for n, t in zip(ps.names, texts, strict=True)]
     return (
         _environment()
         .get_template("parameter_homotopy.input.j2")

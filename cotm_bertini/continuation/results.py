@@ -43,7 +43,7 @@ def finish(
         "spec": spec.to_json(),
         "key": spec.key(),
         "command": command,
-        "points": len(spec.grid()),
+        "points": spec.size(),
         "rows": len(table),
         "events": len(events),
         "status": "incomplete" if incomplete else "ok",

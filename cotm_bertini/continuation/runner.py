@@ -10,44 +10,66 @@ from __future__ import annotations
 import json
 import os
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 
-import pandas as pd
+import numpy as np
 
 from ..analysis.classify import read_table
 from ..errors import ParameterError
-from ..fs import write_csv, write_json
+from ..fs import atomic_write_text, columns_csv, write_json
 from ..params import Params
-from ..point import solve_point
+from ..point import PointSolution, solve_point
 from ..settings import Settings
 from .spec import SweepSpec
 
 SPEC_FILE = "sweep.json"
 
 
-def point_table(params: Params, settings: Settings, values: dict[str, float]) -> pd.DataFrame:
-    """All finite solutions at one point, classified, with how they were obtained."""
-    solved = solve_point(params, settings)
-    table = solved.table.copy()
-    table.insert(0, "point", -1)
-    for k, name in enumerate(values):
-        table.insert(1 + k, name, values[name])
+def point_columns(
+    solved: PointSolution, values: dict[str, float], index: int = -1
+) -> dict[str, np.ndarray]:
+    """A point's rows as columns: point, the swept values, the solutions, how they were found."""
+    cols = solved.columns
+    n = len(cols["solution_id"])
     homotopy = solved.details.get("homotopy")
-    table["method"] = homotopy["method"] if homotopy else f"cli ({solved.engine['flavour']})"
+    method = homotopy["method"] if homotopy else f"cli ({solved.engine['flavour']})"
     lost = solved.counts["lost_paths"]
-    table["lost_paths"] = pd.array([lost] * len(table), dtype="Int64")
-    table["status"] = solved.status
+    out = {"point": np.full(n, index)}
+    out.update({name: np.full(n, float(v)) for name, v in values.items()})
+    out.update(cols)
+    out["method"] = np.full(n, method, dtype=object)
+    out["lost_paths"] = np.full(n, np.nan if lost is None else float(lost))
+    out["status"] = np.full(n, solved.status, dtype=object)
+    return out
+
+
+def point_table(params: Params, settings: Settings, values: dict[str, float]):
+    """All finite solutions at one point, classified, with how they were obtained (DataFrame)."""
+    import pandas as pd
+
+    table = pd.DataFrame(point_columns(solve_point(params, settings), values))
+    table["lost_paths"] = table["lost_paths"].astype("Int64")
     return table
 
 
-def _point_task(args: tuple) -> tuple[int, pd.DataFrame, float]:
-    index, spec_json = args
-    spec = SweepSpec.from_json(spec_json)
-    start = time.perf_counter()
-    table = point_table(spec.params_at(index), point_settings(spec), spec.grid()[index])
-    table["point"] = index
-    return index, table, time.perf_counter() - start
+def solve_run(spec: SweepSpec, indices: list[int]) -> Iterator[tuple[int, str, int]]:
+    """Solve grid points in order, each continued from the one before when they are neighbours:
+    yields (index, the point's CSV text, lost paths)."""
+    settings = point_settings(spec)
+    warm, previous = None, None
+    for index in indices:
+        if previous is None or not spec.neighbours(previous, index):
+            warm = None
+        solved = solve_point(spec.params_at(index), settings, warm=warm)
+        warm, previous = solved.warm, index
+        cols = point_columns(solved, spec.values_at(index), index)
+        yield index, columns_csv(cols), int(np.nan_to_num(cols["lost_paths"][:1]).sum())
+
+
+def _run_task(args: tuple) -> list[tuple[int, str, int]]:
+    indices, spec_json = args
+    return list(solve_run(SweepSpec.from_json(spec_json), indices))
 
 
 def point_settings(spec: SweepSpec) -> Settings:
@@ -63,7 +85,9 @@ def point_file(folder: Path, index: int) -> Path:
 
 def pending_points(spec: SweepSpec, folder: Path) -> list[int]:
     """Indices of the grid points that have no finished point file yet."""
-    return [i for i in range(len(spec.grid())) if not point_file(folder, i).is_file()]
+    points = folder / "points"
+    done = {p.name for p in points.glob("*.csv")} if points.is_dir() else set()
+    return [i for i in range(spec.size()) if point_file(folder, i).name not in done]
 
 
 def prepare(spec: SweepSpec, folder: Path) -> Path:
@@ -97,7 +121,7 @@ def warm_generic_sets(spec: SweepSpec) -> None:
     from ..backends.homotopy import generic_set
     from ..model.compiled import parametric_system
 
-    structures = {spec.params_at(i).zfl for i in range(len(spec.grid()))}
+    structures = {spec.params_at(i).zfl for i in range(spec.size())}
     for zfl in sorted(structures):
         generic_set(parametric_system(zfl), spec.settings["seed"])
 
@@ -109,58 +133,64 @@ def run_points(
     scheduler: str | None = None,
     progress: Callable[[int, int, int], None] | None = None,
 ) -> dict:
-    """Solve every pending point (local processes, or a Dask cluster) and store each atomically."""
+    """Solve every pending point (local processes, or a Dask cluster) and store each atomically.
+
+    Pending points are cut into runs of grid neighbours (snake order over a 2-D grid); each run
+    is solved in order on one worker, every point continued from the one before.
+    """
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise ParameterError(f"--workers {workers!r}: must be an integer >= 1")
     todo = pending_points(spec, folder)
-    grid = spec.grid()
-    stats = {"points": len(grid), "skipped": len(grid) - len(todo), "solved": 0, "lost_paths": 0}
+    total = spec.size()
+    stats = {"points": total, "skipped": total - len(todo), "solved": 0, "lost_paths": 0}
     stats["seconds"] = 0.0
     if not todo:
         return stats
     warm_generic_sets(spec)
     start = time.perf_counter()
-    tasks = [(i, spec.to_json()) for i in todo]
-    for index, table, _ in _execute(tasks, workers, scheduler):
-        write_csv(point_file(folder, index), table)
+    runs = spec.runs(todo, parts=1 if (workers == 1 and scheduler is None) else 2 * workers)
+    for index, text, lost in _execute(runs, spec, workers, scheduler):
+        atomic_write_text(point_file(folder, index), text)
         stats["solved"] += 1
-        lost = table["lost_paths"].dropna()
-        stats["lost_paths"] += int(lost.max()) if len(lost) else 0
+        stats["lost_paths"] += lost
         if progress:
-            progress(stats["solved"], len(tasks), stats["lost_paths"])
+            progress(stats["solved"], len(todo), stats["lost_paths"])
     stats["seconds"] = time.perf_counter() - start
     return stats
 
 
-def _execute(tasks: list[tuple], workers: int, scheduler: str | None) -> Iterable[tuple]:
+def _execute(
+    runs: list[list[int]], spec: SweepSpec, workers: int, scheduler: str | None
+) -> Iterable[tuple[int, str, int]]:
+    if scheduler is None and workers == 1:
+        for run in runs:
+            yield from solve_run(spec, run)  # in process: point by point, progress as it goes
+        return
+    tasks = [(run, spec.to_json()) for run in runs]
     if scheduler is not None:
         from distributed import Client, as_completed
 
         with Client(scheduler) as client:
-            futures = client.map(_point_task, tasks, pure=False)
-            for fut in as_completed(futures):
-                yield fut.result()
-        return
-    if workers == 1:
-        for t in tasks:
-            yield _point_task(t)
+            for fut in as_completed(client.map(_run_task, tasks, pure=False)):
+                yield from fut.result()
         return
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
     ctx = mp.get_context("spawn")  # the bertini module is not fork-safe with its threads
     with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
-        futures = [pool.submit(_point_task, t) for t in tasks]
-        for fut in as_completed(futures):
-            yield fut.result()
+        for fut in as_completed([pool.submit(_run_task, t) for t in tasks]):
+            yield from fut.result()
 
 
-def assemble(spec: SweepSpec, folder: Path) -> pd.DataFrame:
-    """All point files as one table, in grid order (errors if a point is missing)."""
+def assemble(spec: SweepSpec, folder: Path):
+    """All point files as one table (DataFrame), in grid order (errors if a point is missing)."""
+    import pandas as pd
+
     missing = pending_points(spec, folder)
     if missing:
         raise RuntimeError(f"{folder}: {len(missing)} points not solved yet (first {missing[0]})")
-    frames = [read_table(point_file(folder, i)) for i in range(len(spec.grid()))]
+    frames = [read_table(point_file(folder, i)) for i in range(spec.size())]
     return pd.concat(frames, ignore_index=True)
 
 

@@ -63,7 +63,7 @@ class SweepSpec:
         elif self.values2 is not None:
             raise ParameterError("values2 given without param2")
         Settings(**self.settings)  # validated here, before any work
-        for values in (self.grid()[0], self.grid()[-1]):
+        for values in (self.values_at(0), self.values_at(self.size() - 1)):
             make_params(None, {**self.base, **values})  # a bad range fails here
 
     @classmethod
@@ -82,9 +82,54 @@ class SweepSpec:
             return [{self.param: v} for v in self.values]
         return [{self.param: u, self.param2: w} for u, w in product(self.values, self.values2)]
 
+    def size(self) -> int:
+        """The number of grid points."""
+        return len(self.values) * (len(self.values2) if self.param2 else 1)
+
+    def values_at(self, index: int) -> dict[str, float]:
+        """The swept values of grid point `index`."""
+        if self.param2 is None:
+            return {self.param: self.values[index]}
+        i, j = divmod(index, len(self.values2))
+        return {self.param: self.values[i], self.param2: self.values2[j]}
+
+    def neighbours(self, a: int, b: int) -> bool:
+        """Whether grid points a and b are next to each other (one step in one parameter)."""
+        if self.param2 is None:
+            return abs(a - b) == 1
+        n2 = len(self.values2)
+        (ia, ja), (ib, jb) = divmod(a, n2), divmod(b, n2)
+        return abs(ia - ib) + abs(ja - jb) == 1
+
+    def snake(self) -> list[int]:
+        """Every grid index, each one a neighbour of the one before (rows alternate direction)."""
+        if self.param2 is None:
+            return list(range(len(self.values)))
+        n2 = len(self.values2)
+        return [
+            i * n2 + (j if i % 2 == 0 else n2 - 1 - j)
+            for i in range(len(self.values))
+            for j in range(n2)
+        ]
+
+    def runs(self, todo: list[int], parts: int) -> list[list[int]]:
+        """The points of `todo` in snake order, cut into runs of neighbours, then into about
+        `parts` pieces of similar length (one piece per task)."""
+        pending = set(todo)
+        runs: list[list[int]] = []
+        for index in self.snake():
+            if index not in pending:
+                continue
+            if runs and self.neighbours(runs[-1][-1], index):
+                runs[-1].append(index)
+            else:
+                runs.append([index])
+        size = max(1, -(-len(todo) // max(parts, 1)))
+        return [run[k : k + size] for run in runs for k in range(0, len(run), size)]
+
     def params_at(self, index: int) -> Params:
         """The full parameter set of grid point `index`."""
-        return Params(**{**self.base, **self.grid()[index]})
+        return Params(**{**self.base, **self.values_at(index)})
 
     def to_json(self) -> dict:
         """JSON-able form (see from_json)."""

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 
 from ..columns import reference
 from ..errors import ParameterError
-from ..fs import atomic_write_text, partial_name, timestamp, write_csv, write_json
+from ..fs import atomic_write_text, columns_csv, partial_name, timestamp, write_json
 from ..versions import versions
 
 if TYPE_CHECKING:  # the solve path only: a cache hit must not load numpy or pandas
@@ -54,11 +54,11 @@ def solve_record(point: PointSolution, tolerances: dict, label: str, key: str | 
         "timings": dict(point.timings),
         "cache_key": key,
     }
-    record["summary"] = summary_text(record, point.table)
+    record["summary"] = summary_text(record, point.columns)
     return record
 
 
-def summary_text(record: dict, table) -> str:
+def summary_text(record: dict, table: dict) -> str:
     """The console report of a solve: counts, the real solutions (the caller adds a label)."""
     c, engine = record["counts"], record["engine"]
     closed = c["closed_form_endpoints"]
@@ -70,19 +70,34 @@ def summary_text(record: dict, table) -> str:
         + f"; {engine['flavour']} ({engine['path']} {engine['version']}) "
         f"{record['timings'].get('solve', 0.0):.2f} s"
     ]
-    real = table[table["is_real"].astype(bool)]
-    if len(real):
-        shown = real[SUMMARY_COLUMNS].copy()
-        for col in ("gamma1_deg", "gamma2_deg"):
-            # Wrap after rounding to the printed digits: 359.99996 prints as 0.0000, not 360.
-            shown[col] = shown[col].round(4) % 360.0
-        lines.append(shown.to_string(index=False, float_format=lambda v: f"{v:.4f}"))
+    real = [k for k, r in enumerate(table["is_real"]) if r]
+    if real:
+        lines.append(_real_rows_text(table, real))
     return "\n".join(lines)
+
+
+def _real_rows_text(table: dict, rows: list[int]) -> str:
+    """The real solutions as an aligned text table (angles wrapped after rounding to 4 digits,
+    so 359.99996 prints as 0.0000, not 360.0000)."""
+
+    def fmt(name: str, value) -> str:
+        if isinstance(value, float):
+            if name.startswith("gamma"):
+                value = round(value, 4) % 360.0
+            return f"{value:.4f}"
+        return str(value)
+
+    cells = [[fmt(n, table[n][k].item() if hasattr(table[n][k], "item") else table[n][k])
+              for n in SUMMARY_COLUMNS] for k in rows]  # fmt: skip
+    widths = [max(len(n), *(len(r[j]) for r in cells)) for j, n in enumerate(SUMMARY_COLUMNS)]
+    head = " ".join(n.rjust(w) for n, w in zip(SUMMARY_COLUMNS, widths, strict=True))
+    body = [" ".join(c.rjust(w) for c, w in zip(r, widths, strict=True)) for r in cells]
+    return "\n".join([head, *body])
 
 
 def write_solution_files(folder: Path, point: PointSolution) -> None:
     """solutions.csv, columns.md and the input file (unless the solver wrote it)."""
-    write_csv(folder / SOLUTIONS_CSV, point.table)
+    atomic_write_text(folder / SOLUTIONS_CSV, columns_csv(point.columns))
     atomic_write_text(folder / COLUMNS_MD, reference("solutions"))
     if not (folder / "input").exists():
         atomic_write_text(folder / "input", point.input_text)

@@ -9,14 +9,16 @@ source (equations.py, kinematics.py), so an edit of either regenerates them.
 from __future__ import annotations
 
 import hashlib
-import importlib.util
 import json
+import marshal
+import sys
+import types
 from functools import cache
 from pathlib import Path
 
 import numpy as np
 
-from ..fs import atomic_write_text, cache_root
+from ..fs import atomic_write_bytes, atomic_write_text, cache_root
 from ..params import Params
 from .polynomial import ParametricSystem, PolySystem
 
@@ -68,9 +70,21 @@ def _generated():
         from .equations import generated_source
 
         _write(path, generated_source())
-    spec = importlib.util.spec_from_file_location(f"cotm_numeric_{_source_hash()}", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    # The generated source is large: compiling it costs ~0.1 s a process, so the code object is
+    # kept too (per Python version), whatever PYTHONDONTWRITEBYTECODE says.
+    compiled = path.with_name(f"{path.stem}-{sys.implementation.cache_tag}.code")
+    code = None
+    if compiled.is_file():
+        try:
+            code = marshal.loads(compiled.read_bytes())
+        except (ValueError, EOFError, TypeError):
+            code = None  # damaged: compile again
+    if code is None:
+        code = compile(path.read_text(), str(path), "exec")
+        atomic_write_bytes(compiled, marshal.dumps(code))
+    module = types.ModuleType(f"cotm_numeric_{_source_hash()}")
+    module.__file__ = str(path)
+    exec(code, module.__dict__)
     return module
 
 
@@ -104,7 +118,14 @@ def energy_hessian(params: Params, g1, g2) -> np.ndarray:
     return np.stack(flat, axis=-1).reshape(*g1.shape, 2, 2)
 
 
-def tan_half_jacobian(params: Params, point: tuple[complex, ...]) -> np.ndarray:
-    """Jacobian of the paper's equations (F, tau, C1, C2) in (x1, x2, d1, d2) at one point."""
+def tan_half_jacobian(params: Params, point: tuple) -> np.ndarray:
+    """Jacobian of the paper's equations (F, tau, C1, C2) in (x1, x2, d1, d2): one point of
+    scalars -> (m, m); or arrays of n points -> (n, m, m)."""
     fn = getattr(_generated(), f"tan_half_jacobian_{_tag(params.zfl)}")
-    return np.array(fn(*point, *_values(params)), dtype=complex)
+    arrays = [np.asarray(v) for v in point]
+    shape = np.broadcast_shapes(*(a.shape for a in arrays))
+    rows = fn(*arrays, *_values(params))
+    jac = np.array(
+        [[np.broadcast_to(np.asarray(v, dtype=complex), shape) for v in row] for row in rows]
+    )
+    return np.moveaxis(jac, (0, 1), (-2, -1))

@@ -50,6 +50,37 @@ class ParametricSystem:
             tuple(data["texts"]),
         )
 
+    def fix(self, values: dict[str, complex]) -> ParametricSystem:
+        """The same system with the named parameters replaced by values (folded into the
+        coefficients); the others stay parameters. `texts` is empty: render from the terms."""
+        keep = [k for k, n in enumerate(self.parameters) if n not in values]
+        fixed = np.array(
+            [values[n] if n in values else 1.0 for n in self.parameters], dtype=complex
+        )
+        fold = np.ones(len(self.parameters), dtype=bool)
+        fold[keep] = False
+        var_exps, par_exps, coeffs = [], [], []
+        for ve, pe, c in zip(self.var_exps, self.par_exps, self.coeffs, strict=True):
+            term = c * np.prod(fixed[None, fold] ** pe[:, fold], axis=1)
+            both = np.hstack([ve, pe[:, keep]])
+            uniq, inverse = np.unique(both, axis=0, return_inverse=True)
+            total = np.zeros(len(uniq), dtype=complex)
+            np.add.at(total, inverse.ravel(), term)
+            nz = total != 0
+            total = total.real if not np.any(total.imag) else total
+            var_exps.append(uniq[nz, : len(self.variables)])
+            par_exps.append(uniq[nz, len(self.variables) :])
+            coeffs.append(total[nz])
+        return ParametricSystem(
+            self.variables,
+            self.names,
+            tuple(self.parameters[k] for k in keep),
+            tuple(var_exps),
+            tuple(par_exps),
+            tuple(coeffs),
+            (),
+        )
+
     def instantiate(self, values: Sequence[complex]) -> PolySystem:
         """The numeric system at parameter values (same order as `parameters`)."""
         p = np.asarray(values)

@@ -1,0 +1,72 @@
+"""Sweeps continue each point from its neighbour; every continued point is checked, and a failed
+check falls back to the generic route (answers compared with independent solves)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from cotm_bertini.backends import homotopy
+from cotm_bertini.continuation.spec import SweepSpec
+from cotm_bertini.params import Params
+from cotm_bertini.point import solve_point
+from cotm_bertini.settings import Settings
+
+
+def _angles(table) -> np.ndarray:
+    cols = ["gamma1_deg", "gamma2_deg", "gamma1_imag_deg", "gamma2_imag_deg", "d1", "d2"]
+    return np.sort(table[cols].to_numpy(), axis=0)
+
+
+@pytest.mark.parametrize("step", [0.05, 1.0])
+def test_continued_point_equals_the_generic_route(step):
+    """From L01 = 10.9 to 10.9 + step (across the fold at 11.0128 for step 1): the continued
+    solutions equal an ab-initio total-degree solve by the bertini2 command."""
+    a = solve_point(Params(L01=10.9))
+    assert a.warm is not None
+    b = solve_point(Params(L01=10.9 + step), warm=a.warm)
+    assert b.details["homotopy"]["method"] == "continued from the neighbouring point"
+    fresh = solve_point(Params(L01=10.9 + step), Settings(engine="cli"))
+    assert len(b.table) == len(fresh.table)
+    assert np.abs(_angles(b.table) - _angles(fresh.table)).max() < 1e-6
+    assert b.counts["stable"] == fresh.counts["stable"]
+
+
+def test_a_path_that_jumps_sends_the_point_to_the_generic_route(monkeypatch):
+    """Two continued paths ending at one point (a jump): refused, solved from the generic set,
+    and the method says why."""
+    real = homotopy._run_homotopy
+
+    def jumping(*args, **kw):
+        meta, pts = real(*args, **kw)
+        pts = list(pts)
+        pts[1] = pts[0]  # path 1 lands where path 0 did
+        return meta, pts
+
+    a = solve_point(Params(L01=5.0))
+    monkeypatch.setattr(homotopy, "_run_homotopy", jumping)
+    b = solve_point(Params(L01=5.1), warm=a.warm)
+    method = b.details["homotopy"]["method"]
+    assert method.startswith("parameter homotopy") and "two paths ended at the same point" in method
+    monkeypatch.undo()
+    fresh = solve_point(Params(L01=5.1))
+    assert np.abs(_angles(b.table) - _angles(fresh.table)).max() < 1e-9
+
+
+def test_a_start_of_another_structure_is_not_continued():
+    """L01 = 0 (spring 1 zero-free-length) has other variables: the next point starts afresh."""
+    a = solve_point(Params(L01=0.0))
+    b = solve_point(Params(L01=0.05), warm=a.warm)
+    assert "another structure" in b.details["homotopy"]["method"]
+    assert b.counts["distinct_solutions"] == 22
+
+
+def test_runs_follow_the_grid_in_snake_order():
+    """A 3 x 4 grid: one run visits every point, each a neighbour of the one before; pending
+    points of a resumed sweep are cut where the grid order skips."""
+    spec = SweepSpec(Params().as_dict(), "L01", (1.0, 2.0, 3.0), "L02", (1.0, 2.0, 3.0, 4.0))
+    (run,) = spec.runs(list(range(12)), parts=1)
+    assert sorted(run) == list(range(12))
+    assert all(spec.neighbours(a, b) for a, b in zip(run[:-1], run[1:], strict=True))
+    assert spec.runs([0, 1, 5, 6], parts=1) == [[0, 1], [6, 5]]
+    assert [len(r) for r in spec.runs(list(range(12)), parts=4)] == [3, 3, 3, 3]

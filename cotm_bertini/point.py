@@ -150,7 +150,7 @@ def solve_point(
 
 
 def _homotopy(params: Params, settings: Settings, ps, t: Timings, warm) -> tuple:
-    from .backends.homotopy import solve_target
+    from .backends.target import solve_target
 
     with t.stage("solve"):
         hs = solve_target(ps, params, settings, warm)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cotm_bertini.backends import homotopy
+from cotm_bertini.backends import neighbour, target
 from cotm_bertini.continuation.spec import SweepSpec
 from cotm_bertini.params import Params
 from cotm_bertini.point import solve_point
@@ -18,24 +18,53 @@ def _angles(table) -> np.ndarray:
     return np.sort(table[cols].to_numpy(), axis=0)
 
 
-@pytest.mark.parametrize("step", [0.05, 1.0])
-def test_continued_point_equals_the_generic_route(step):
-    """From L01 = 10.9 to 10.9 + step (across the fold at 11.0128 for step 1): the continued
-    solutions equal an ab-initio total-degree solve by the bertini2 command."""
+NEWTON = "Newton from the neighbouring point (complete)"
+SEGMENT = "continued from the neighbouring point"
+
+
+@pytest.mark.parametrize(("step", "method"), [(0.05, NEWTON), (1.0, SEGMENT)])
+def test_continued_point_equals_the_generic_route(step, method):
+    """From L01 = 10.9 to 10.9 + step: Newton for a short step; across the fold at 11.0128 (step
+    1) Newton cannot find every root (a pair is born there) and the segment homotopy does. Both
+    equal an ab-initio total-degree solve by the bertini2 command."""
     a = solve_point(Params(L01=10.9))
     assert a.warm is not None
     b = solve_point(Params(L01=10.9 + step), warm=a.warm)
-    assert b.details["homotopy"]["method"] == "continued from the neighbouring point"
+    assert b.details["homotopy"]["method"] == method
     fresh = solve_point(Params(L01=10.9 + step), Settings(engine="cli"))
     assert len(b.table) == len(fresh.table)
     assert np.abs(_angles(b.table) - _angles(fresh.table)).max() < 1e-6
     assert b.counts["stable"] == fresh.counts["stable"]
 
 
+def test_newton_refuses_a_set_it_cannot_prove_complete():
+    """A neighbour's set with one start doubled: two starts converge to one root, so Newton
+    cannot have found every root and refuses; the point is solved by another route, and the
+    answer equals a fresh solve."""
+    from dataclasses import replace
+
+    from cotm_bertini.backends.homotopy import generic_set
+    from cotm_bertini.model.compiled import parametric_system
+
+    a = solve_point(Params(L01=5.0))
+    points = a.warm.points.copy()
+    points[1] = points[0]
+    doubled = replace(a.warm, points=points)
+    ps = parametric_system((False, True))
+    result, why = neighbour.newton_continue(ps, generic_set(ps, 1), doubled, Params(L01=5.05))
+    assert result is None and why == "two starts converged to one root"
+    b = solve_point(Params(L01=5.05), warm=doubled)
+    assert b.details["homotopy"]["method"] != NEWTON
+    fresh = solve_point(Params(L01=5.05))
+    assert np.abs(_angles(b.table) - _angles(fresh.table)).max() < 1e-9
+
+
 def test_a_path_that_jumps_sends_the_point_to_the_generic_route(monkeypatch):
     """Two continued paths ending at one point (a jump): refused, solved from the generic set,
     and the method says why."""
-    real = homotopy._run_homotopy
+    # Newton off, so the segment homotopy is what continues the point.
+    monkeypatch.setattr(target, "newton_continue", lambda *a: (None, "off for this test"))
+    real = neighbour._run_homotopy
 
     def jumping(*args, **kw):
         meta, pts = real(*args, **kw)
@@ -44,7 +73,7 @@ def test_a_path_that_jumps_sends_the_point_to_the_generic_route(monkeypatch):
         return meta, pts
 
     a = solve_point(Params(L01=5.0))
-    monkeypatch.setattr(homotopy, "_run_homotopy", jumping)
+    monkeypatch.setattr(neighbour, "_run_homotopy", jumping)
     b = solve_point(Params(L01=5.1), warm=a.warm)
     method = b.details["homotopy"]["method"]
     assert method.startswith("parameter homotopy") and "two paths ended at the same point" in method

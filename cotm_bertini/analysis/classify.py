@@ -79,7 +79,10 @@ def _merge(params: Params, system: PolySystem, endpoints: Endpoints, tol: Tolera
     x0 = np.where(is_d, endpoints.points / params.L3, endpoints.points)
     acc = np.nan_to_num(endpoints.accuracy_estimate, nan=0.0)
     x0, snapped = snap_zero_length(params, endpoints.variables, x0, tol.snap)
-    x, res = newton_refine(system, x0, tol.newton_steps if len(x0) else 0)
+    # The snapped points are exact (and exactly singular): Newton has nothing to do there.
+    x, res = x0.copy(), np.zeros(len(x0))
+    if (~snapped).any():
+        x[~snapped], res[~snapped] = newton_refine(system, x0[~snapped], tol.newton_steps)
     # Our own condition number at the refined point: Bertini's estimate is taken wherever its
     # endgame stopped and varies by orders of magnitude between runs near a singular root.
     jac_cond = np.linalg.cond(system.jacobian(x)) if len(x) else np.zeros(0)

@@ -18,14 +18,22 @@ def newton_refine(system: PolySystem, x: np.ndarray, steps: int) -> tuple[np.nda
         f = system.evaluate(x)
         jac = system.jacobian(x)
         step = np.zeros_like(x)
-        ok = np.isfinite(jac).all(axis=(1, 2)) & (np.linalg.cond(jac) < 1e14)
-        if ok.any():
+        ok = np.isfinite(jac).all(axis=(1, 2))
+        try:
             step[ok] = np.linalg.solve(jac[ok], f[ok][..., None])[..., 0]
-        trial = x - step
+        except np.linalg.LinAlgError:  # an exactly singular matrix: solve only the sound ones
+            ok &= np.linalg.cond(jac) < 1e14
+            step[ok] = np.linalg.solve(jac[ok], f[ok][..., None])[..., 0]
+        ok &= np.isfinite(step).all(axis=1)
+        if not (np.abs(step[ok]) > 4e-14 * (1 + np.abs(x[ok]))).any():
+            break  # converged to rounding: a further step cannot lower the residual
+        trial = x - np.where(ok[:, None], step, 0)
         new = np.abs(system.evaluate(trial) / scale).max(axis=1)
         better = ok & (new < res)
         x[better] = trial[better]
         res[better] = new[better]
+        if not better.any():
+            break
     return x, res
 
 

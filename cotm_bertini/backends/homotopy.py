@@ -1,4 +1,4 @@
-"""The `homotopy` engine: Bertini 2 in-process, by parameter homotopy from a generic solution set.
+"""Bertini 2 in-process: generic solution sets, parameter homotopies from them, ab initio solves.
 
 A total-degree solve (ab initio) at random complex parameters p0 gives the generic solution set.
 Any real target p1 is then reached by tracking those solutions while every parameter moves on
@@ -27,7 +27,7 @@ from ..params import Params
 from ..settings import Settings
 from ..versions import bertini2_version
 from .endpoints import Endpoints
-from .render import parametric_texts, render_parameter_homotopy, render_system
+from .render import render_parameter_homotopy, render_system
 
 _SUCCESS = "Success"
 DOUBLE_FINAL_TOLERANCE = 1e-8
@@ -361,94 +361,6 @@ def zero_length_roots(params: Params, variables: tuple[str, ...]) -> Endpoints:
     return Endpoints.from_records(variables, records)
 
 
-@dataclass(frozen=True, eq=False)
-class WarmStart:
-    """A real parameter set with its complete set of nonsingular finite solutions (as many as
-    the generic set has, in normalised units): a start for the next point of a sweep."""
-
-    params: Params
-    points: np.ndarray
-    generic_key: str
-
-
-@dataclass(frozen=True)
-class HomotopySolve:
-    """Every finite endpoint at a target and how the homotopy got there."""
-
-    endpoints: Endpoints  # tracked endpoints, then the closed-form d = 0 roots
-    info: dict
-    generic: GenericSet
-    input_text: str
-    warm: WarmStart | None = None  # this target as a start for a neighbouring one
-
-
-def solve_target(
-    ps: ParametricSystem,
-    params: Params,
-    settings: Settings = Settings(),
-    warm: WarmStart | None = None,
-) -> HomotopySolve:
-    """Every finite endpoint at `params` (tracked ones plus the closed-form d = 0 artefacts).
-
-    With `warm` (a neighbouring real point of the same structure, solved completely), its
-    solutions are continued to `params` (see `continue_from`); if that fails a check, the point
-    is solved from the generic set as without it. From the generic set: a lost path, or fewer
-    finite endpoints than the generic count, sends the point to a second, independent generic
-    set (a new random start, like Paramotopy's new gamma); if that does not settle it, the target
-    is solved ab initio. `info["method"]` says which route, `info["lost"]` how many paths were
-    lost.
-
-    The target is solved in units of L3 and max(k1, k2) (equilibria do not change when every
-    length, or every stiffness, is scaled), so the paths see numbers of order one whatever the
-    user's units; the spring lengths are scaled back.
-    """
-    deadline = None if settings.timeout is None else time.perf_counter() + settings.timeout
-    gs = generic_set(ps, settings.seed)
-    unit = params.normalized()
-    result, note = None, ""
-    if warm is not None:
-        result, note = continue_from(ps, gs, warm, params, settings, deadline)
-    if result is None:
-        result = _from_generic(ps, gs, unit, settings, deadline)
-        if note:
-            result[1]["method"] += f" ({note})"
-    endpoints, info, text = result
-    complete = info["lost"] == 0 and info["finite"] == len(gs.points)
-    warm_next = WarmStart(params, endpoints.points, gs.key) if complete else None
-    is_d = np.array([v.startswith("d") for v in ps.variables])
-    scaled = np.where(is_d, endpoints.points * params.L3, endpoints.points)
-    endpoints = endpoints.with_points(scaled)
-    info.update(
-        units={"length": params.L3, "stiffness": max(params.k1, params.k2)},
-        generic_key=gs.key,
-        generic_paths=gs.paths,
-        generic_finite=gs.finite_endpoints,
-    )
-    closed = zero_length_roots(params, ps.variables)
-    return HomotopySolve(endpoints.concat(closed), info, gs, text, warm_next)
-
-
-def _from_generic(ps, gs: GenericSet, unit: Params, settings: Settings, deadline) -> tuple:
-    """Track the generic set to the (normalised) target, with the fallbacks of solve_target."""
-    endpoints, rep = track(ps, gs, unit, settings, deadline)
-    method = "parameter homotopy" + (" + adaptive retrack" if rep.retracked_adaptive else "")
-    if rep.lost or rep.finite < len(gs.points):
-        gs2 = generic_set(ps, settings.seed + SECOND_START)
-        endpoints2, rep2 = track(ps, gs2, unit, settings, deadline)
-        if rep2.lost == 0 and not rep.lost and rep2.finite == rep.finite:
-            method += "; finite count confirmed from a second start"
-        elif rep2.lost == 0 and rep2.finite >= rep.finite:
-            endpoints, rep = endpoints2, rep2
-            method = "parameter homotopy from a second start (the first lost paths)"
-        else:
-            endpoints, lost = ab_initio(ps, unit, settings)
-            rep.finite, rep.lost = len(endpoints), lost
-            method = "ab initio (both parameter homotopies lost paths)"
-    target = {n: getattr(unit, n) for n in ps.parameters}
-    text = render_parameter_homotopy(ps, gs.start, target)
-    return endpoints, {**rep.as_dict(), "method": method}, text
-
-
 def ab_initio(
     ps: ParametricSystem, params: Params, settings: Settings = Settings()
 ) -> tuple[Endpoints, int]:
@@ -476,93 +388,3 @@ def ab_initio(
         elif code not in ("GoingToInfinity", "SecurityMaxNormReached") and m.is_finite:
             lost += 1
     return Endpoints.from_records(ps.variables, rows), lost
-
-
-# --- continuation from a neighbouring real point ---------------------------------------------
-
-# Continuation steps: the segment between neighbouring sweep points is short, so the tracker may
-# take large steps (the checks below catch a path that jumps).
-_CONTINUATION_STEPS = {"max_step_size": "0.5", "initial_step_size": "0.5"}
-
-
-def continue_from(
-    ps: ParametricSystem,
-    gs: GenericSet,
-    warm: WarmStart,
-    params: Params,
-    settings: Settings,
-    deadline: float | None,
-) -> tuple[tuple | None, str]:
-    """The solutions at `params` continued from a neighbouring real point's complete set.
-
-    Only the parameters that differ (in normalised units) move, from the warm point (t = 1) to
-    the target (t = 0), with a random complex detour * t (1 - t) so the path misses the real
-    folds between the two points (the gamma trick of parameter homotopies). Checked: every path
-    ends finite and in success, as many as the generic count, no two at the same point (a path
-    that jumped). Returns ((endpoints, info, input text), "") or (None, why it was refused).
-    """
-    a, b = warm.params.normalized(), params.normalized()
-    if warm.generic_key != gs.key:
-        return None, "the previous point has another structure"
-    if len(warm.points) != len(gs.points):
-        return None, "the previous point's solution set is incomplete"
-    free = [n for n in ps.parameters if getattr(a, n) != getattr(b, n)]
-    if not free:
-        free = ps.parameters[:1]  # the same point: a loop through the complex plane
-    fixed = tuple((n, getattr(b, n)) for n in ps.parameters if n not in free)
-    sub, texts = _fixed_system(ps, gs.key, fixed)
-    # Reproducible: the detour depends on the seed and the target only (hash of floats is stable).
-    rng = np.random.default_rng(abs(hash((settings.seed, *(getattr(b, n) for n in free)))))
-    start = {n: getattr(a, n) for n in free}
-    target = {n: getattr(b, n) for n in free}
-    scale = {n: abs(target[n] - start[n]) or 1e-3 for n in free}
-    detour = {
-        n: scale[n] * complex(rng.uniform(-0.5, 0.5), rng.choice([-1, 1]) * rng.uniform(0.5, 1))
-        for n in free
-    }
-    text = render_parameter_homotopy(sub, start, target, detour, texts)
-    meta, pts = _run_homotopy(sub, text, warm.points, target, settings, deadline)
-    rows, failed = [], 0
-    for i, (m, p) in enumerate(zip(meta, pts, strict=True)):
-        if _code(m) == _SUCCESS and m.is_finite:
-            rows.append(endpoint_record(i, m, p))
-        else:
-            failed += 1
-    results = {i: (m, p) for i, (m, p) in enumerate(zip(meta, pts, strict=True))}
-    if failed:
-        return None, f"{failed} paths did not end in success"
-    if _crossing(results, list(results)):
-        return None, "two paths ended at the same point"
-    rep = TrackReport(tracked=len(pts), finite=len(rows), method="continued")
-    info = {**rep.as_dict(), "method": "continued from the neighbouring point", "moved": free}
-    return (Endpoints.from_records(ps.variables, rows), info, text), ""
-
-
-_FIXED: dict[tuple, tuple[ParametricSystem, tuple[str, ...]]] = {}
-
-
-def _fixed_system(ps: ParametricSystem, key: str, fixed: tuple) -> tuple:
-    """`ps` with the `fixed` parameters folded in, and its texts (kept: a sweep reuses them)."""
-    if (key, fixed) not in _FIXED:
-        if len(_FIXED) > 32:
-            _FIXED.clear()
-        sub = ps.fix(dict(fixed))
-        _FIXED[key, fixed] = (sub, parametric_texts(sub))
-    return _FIXED[key, fixed]
-
-
-def _run_homotopy(sub, text: str, points, target: dict, settings: Settings, deadline):
-    """Track `points` along the homotopy `text` in double precision with large steps."""
-    bertini = _bertini()
-    from bertini import nag_algorithm as na
-
-    system = sub.instantiate([target[n] for n in sub.parameters])
-    hom = bertini.parse.system(text)
-    tgt = bertini.parse.system(render_system(system))
-    solver = na.HomotopySolver(hom, list(points), tgt, mptype="double")
-    _configure(solver, settings, "double", deadline)
-    solver.set(**{k: bertini.multiprec.real_mp(v) for k, v in _CONTINUATION_STEPS.items()})
-    solver.solve(show_progress=False)
-    if deadline is not None and time.perf_counter() > deadline:
-        raise SolverError(f"the in-process solve timed out after {settings.timeout:g} s")
-    return solver.solution_metadata(), solver.all_solutions()

@@ -13,7 +13,7 @@ import json
 import marshal
 import sys
 import types
-from functools import cache
+from functools import cache, lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -57,8 +57,10 @@ def parametric_system(zfl: tuple[bool, bool]) -> ParametricSystem:
     return ps
 
 
+@lru_cache(maxsize=16)
 def polynomial_system(params: Params) -> PolySystem:
-    """The equations with the parameter values substituted."""
+    """The equations with the parameter values substituted (the last few kept: a solve asks for
+    the same normalised system in several places)."""
     ps = parametric_system(params.zfl)
     return ps.instantiate([getattr(params, n) for n in ps.parameters])
 

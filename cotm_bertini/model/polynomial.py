@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -115,31 +116,52 @@ class PolySystem:
         """Bezout number: the path count of a total-degree homotopy."""
         return int(np.prod(self.degrees))
 
+    @cached_property
+    def _flat(self) -> tuple[np.ndarray, ...]:
+        # Every term of every function in one table: exponents (T, V), coefficients (T,), and
+        # where each function's terms start, for one vectorised pass over all of them.
+        exps = np.vstack(self.exponents).astype(np.intp)
+        coefs = np.concatenate(self.coefficients).astype(complex)
+        starts = np.cumsum([0] + [len(e) for e in self.exponents[:-1]])
+        return exps, coefs, starts, int(exps.max(initial=0))
+
+    def _powers(self, x: np.ndarray, top: int) -> np.ndarray:
+        """x_v^k for k = 0..top, shape (n, V, top + 1)."""
+        pw = np.empty((*x.shape, top + 1), dtype=complex)
+        pw[..., 0] = 1.0
+        for k in range(1, top + 1):
+            pw[..., k] = pw[..., k - 1] * x
+        return pw
+
+    def _sum_terms(self, terms: np.ndarray, starts: np.ndarray) -> np.ndarray:
+        return np.add.reduceat(terms, starts, axis=1)
+
     def evaluate(self, x: np.ndarray) -> np.ndarray:
         """Values of every function at the rows of x, shape (n_points, n_functions)."""
         x = np.atleast_2d(np.asarray(x, dtype=complex))
-        out = np.empty((x.shape[0], len(self.exponents)), dtype=complex)
-        for i, (e, c) in enumerate(zip(self.exponents, self.coefficients, strict=True)):
-            out[:, i] = np.prod(x[:, None, :] ** e[None, :, :], axis=2) @ c
-        return out
+        exps, coefs, starts, top = self._flat
+        factors = self._powers(x, top)[:, np.arange(x.shape[1]), exps]  # (n, T, V)
+        return self._sum_terms(factors.prod(axis=2) * coefs, starts)
+
+    @cached_property
+    def _flat_jacobian(self) -> tuple[np.ndarray, ...]:
+        # The terms of every d f_i / d x_j, variable-major: exponents lowered by one in x_j and
+        # coefficients times the old exponent (zero where x_j does not occur).
+        exps, coefs, starts, top = self._flat
+        m = exps.shape[1]
+        dexps = np.vstack([np.maximum(exps - np.eye(m, dtype=np.intp)[j], 0) for j in range(m)])
+        dcoefs = np.concatenate([coefs * exps[:, j] for j in range(m)])
+        dstarts = np.concatenate([starts + j * len(coefs) for j in range(m)])
+        return dexps, dcoefs, dstarts, top
 
     def jacobian(self, x: np.ndarray) -> np.ndarray:
         """Jacobian at the rows of x, shape (n_points, n_functions, n_variables)."""
         x = np.atleast_2d(np.asarray(x, dtype=complex))
+        dexps, dcoefs, dstarts, top = self._flat_jacobian
         n, m = x.shape
-        jac = np.zeros((n, len(self.exponents), m), dtype=complex)
-        for i, (e, c) in enumerate(zip(self.exponents, self.coefficients, strict=True)):
-            for j in range(m):
-                ej = e[:, j]
-                mask = ej > 0
-                if not mask.any():
-                    continue
-                de = e[mask].copy()
-                de[:, j] -= 1
-                jac[:, i, j] = np.prod(x[:, None, :] ** de[None, :, :], axis=2) @ (
-                    c[mask] * ej[mask]
-                )
-        return jac
+        factors = self._powers(x, top)[:, np.arange(m), dexps]  # (n, m T, m)
+        sums = self._sum_terms(factors.prod(axis=2) * dcoefs, dstarts)  # (n, m F)
+        return sums.reshape(n, m, len(self.exponents)).transpose(0, 2, 1)
 
     def scale(self) -> np.ndarray:
         """Largest coefficient magnitude of each function, to make residuals relative."""

@@ -1,0 +1,104 @@
+"""One target solved by the homotopy engine: from a neighbour if one is given, else from the
+generic set (with its fallbacks), plus the closed-form d = 0 roots."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model.polynomial import ParametricSystem
+from ..params import Params
+from ..settings import Settings
+from .endpoints import Endpoints
+from .homotopy import (
+    SECOND_START,
+    GenericSet,
+    ab_initio,
+    generic_set,
+    track,
+    zero_length_roots,
+)
+from .neighbour import WarmStart, continue_from, newton_continue
+from .render import render_parameter_homotopy
+
+
+@dataclass(frozen=True)
+class HomotopySolve:
+    """Every finite endpoint at a target and how the homotopy got there."""
+
+    endpoints: Endpoints  # tracked endpoints, then the closed-form d = 0 roots
+    info: dict
+    generic: GenericSet
+    input_text: str
+    warm: WarmStart | None = None  # this target as a start for a neighbouring one
+
+
+def solve_target(
+    ps: ParametricSystem,
+    params: Params,
+    settings: Settings = Settings(),
+    warm: WarmStart | None = None,
+) -> HomotopySolve:
+    """Every finite endpoint at `params` (tracked ones plus the closed-form d = 0 artefacts).
+
+    With `warm` (a neighbouring real point of the same structure, solved completely), its
+    solutions are continued to `params` (see `continue_from`); if that fails a check, the point
+    is solved from the generic set as without it. From the generic set: a lost path, or fewer
+    finite endpoints than the generic count, sends the point to a second, independent generic
+    set (a new random start, like Paramotopy's new gamma); if that does not settle it, the target
+    is solved ab initio. `info["method"]` says which route, `info["lost"]` how many paths were
+    lost.
+
+    The target is solved in units of L3 and max(k1, k2) (equilibria do not change when every
+    length, or every stiffness, is scaled), so the paths see numbers of order one whatever the
+    user's units; the spring lengths are scaled back.
+    """
+    deadline = None if settings.timeout is None else time.perf_counter() + settings.timeout
+    gs = generic_set(ps, settings.seed)
+    unit = params.normalized()
+    result, note = None, ""
+    if warm is not None:
+        result, note = newton_continue(ps, gs, warm, params)
+        if result is None:
+            result, note = continue_from(ps, gs, warm, params, settings, deadline)
+    if result is None:
+        result = _from_generic(ps, gs, unit, settings, deadline)
+        if note:
+            result[1]["method"] += f" ({note})"
+    endpoints, info, text = result
+    complete = info["lost"] == 0 and info["finite"] == len(gs.points)
+    warm_next = WarmStart(params, endpoints.points, gs.key) if complete else None
+    is_d = np.array([v.startswith("d") for v in ps.variables])
+    scaled = np.where(is_d, endpoints.points * params.L3, endpoints.points)
+    endpoints = endpoints.with_points(scaled)
+    info.update(
+        units={"length": params.L3, "stiffness": max(params.k1, params.k2)},
+        generic_key=gs.key,
+        generic_paths=gs.paths,
+        generic_finite=gs.finite_endpoints,
+    )
+    closed = zero_length_roots(params, ps.variables)
+    return HomotopySolve(endpoints.concat(closed), info, gs, text, warm_next)
+
+
+def _from_generic(ps, gs: GenericSet, unit: Params, settings: Settings, deadline) -> tuple:
+    """Track the generic set to the (normalised) target, with the fallbacks of solve_target."""
+    endpoints, rep = track(ps, gs, unit, settings, deadline)
+    method = "parameter homotopy" + (" + adaptive retrack" if rep.retracked_adaptive else "")
+    if rep.lost or rep.finite < len(gs.points):
+        gs2 = generic_set(ps, settings.seed + SECOND_START)
+        endpoints2, rep2 = track(ps, gs2, unit, settings, deadline)
+        if rep2.lost == 0 and not rep.lost and rep2.finite == rep.finite:
+            method += "; finite count confirmed from a second start"
+        elif rep2.lost == 0 and rep2.finite >= rep.finite:
+            endpoints, rep = endpoints2, rep2
+            method = "parameter homotopy from a second start (the first lost paths)"
+        else:
+            endpoints, lost = ab_initio(ps, unit, settings)
+            rep.finite, rep.lost = len(endpoints), lost
+            method = "ab initio (both parameter homotopies lost paths)"
+    target = {n: getattr(unit, n) for n in ps.parameters}
+    text = render_parameter_homotopy(ps, gs.start, target)
+    return endpoints, {**rep.as_dict(), "method": method}, text

@@ -206,10 +206,13 @@ class TrackReport:
     method: str = "parameter homotopy"
     seconds: float = 0.0
     notes: list[str] = field(default_factory=list)
+    input_text: str = ""  # the homotopy as rendered (written to the run folder as `input`)
 
     def as_dict(self) -> dict:
         """For run.json and sweep rows."""
-        return {**self.__dict__, "notes": "; ".join(self.notes)}
+        out = {**self.__dict__, "notes": "; ".join(self.notes)}
+        del out["input_text"]
+        return out
 
 
 def _configure(solver, settings: Settings, mptype: str, deadline: float | None) -> None:
@@ -242,9 +245,8 @@ def _configure(solver, settings: Settings, mptype: str, deadline: float | None) 
 
 
 def _track(
-    ps: ParametricSystem,
+    texts: tuple[str, str],
     gs: GenericSet,
-    target: dict[str, float],
     idx: list[int],
     mptype: str,
     settings: Settings,
@@ -253,8 +255,7 @@ def _track(
     bertini = _bertini()
     from bertini import nag_algorithm as na
 
-    hom = bertini.parse.system(render_parameter_homotopy(ps, gs.start, target))
-    tgt = bertini.parse.system(render_system(ps.instantiate([target[n] for n in ps.parameters])))
+    hom, tgt = (bertini.parse.system(text) for text in texts)
     solver = na.HomotopySolver(hom, [gs.points[i] for i in idx], tgt, mptype=mptype)
     _configure(solver, settings, mptype, deadline)
     solver.solve(show_progress=False)
@@ -278,9 +279,13 @@ def track(
     """
     t0 = time.perf_counter()
     target = {n: getattr(params, n) for n in ps.parameters}
+    texts = (
+        render_parameter_homotopy(ps, gs.start, target),
+        render_system(ps.instantiate([target[n] for n in ps.parameters])),
+    )
     n = len(gs.points)
-    rep = TrackReport(tracked=n)
-    meta, pts = _track(ps, gs, target, list(range(n)), "double", settings, deadline)
+    rep = TrackReport(tracked=n, input_text=texts[0])
+    meta, pts = _track(texts, gs, list(range(n)), "double", settings, deadline)
     results = {i: (meta[i], pts[i]) for i in range(n)}
     redo = [i for i in range(n) if _code(meta[i]) != _SUCCESS or not meta[i].is_finite]
     if _crossing(results, [i for i in range(n) if i not in redo]):
@@ -288,7 +293,7 @@ def track(
         rep.notes.append("path crossing in double precision: all paths re-tracked")
     if redo and settings.mptype == 2:
         rep.retracked_adaptive = len(redo)
-        meta2, pts2 = _track(ps, gs, target, redo, "adaptive", settings, deadline)
+        meta2, pts2 = _track(texts, gs, redo, "adaptive", settings, deadline)
         for k, i in enumerate(redo):
             results[i] = (meta2[k], pts2[k])
     rows = []

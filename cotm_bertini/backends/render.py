@@ -7,6 +7,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from ..fs import cache_root
 from ..model.polynomial import ParametricSystem, PolySystem
 from ..resources import template_texts
 from ..settings import Settings
@@ -16,8 +17,12 @@ from ..settings import Settings
 def _environment():
     import jinja2
 
+    folder = cache_root() / "jinja"
+    folder.mkdir(parents=True, exist_ok=True)
     return jinja2.Environment(
         loader=jinja2.DictLoader(template_texts()),
+        # Compiled templates are kept (keyed by their source): ~10 ms a process saved.
+        bytecode_cache=jinja2.FileSystemBytecodeCache(str(folder)),
         undefined=jinja2.StrictUndefined,
         trim_blocks=True,
         lstrip_blocks=True,

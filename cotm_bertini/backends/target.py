@@ -21,7 +21,6 @@ from .homotopy import (
     zero_length_roots,
 )
 from .neighbour import WarmStart, continue_from, newton_continue
-from .render import render_parameter_homotopy
 
 
 @dataclass(frozen=True)
@@ -99,6 +98,4 @@ def _from_generic(ps, gs: GenericSet, unit: Params, settings: Settings, deadline
             endpoints, lost = ab_initio(ps, unit, settings)
             rep.finite, rep.lost = len(endpoints), lost
             method = "ab initio (both parameter homotopies lost paths)"
-    target = {n: getattr(unit, n) for n in ps.parameters}
-    text = render_parameter_homotopy(ps, gs.start, target)
-    return endpoints, {**rep.as_dict(), "method": method}, text
+    return endpoints, {**rep.as_dict(), "method": method}, rep.input_text

@@ -71,12 +71,14 @@ def match(reference: pd.DataFrame, found: pd.DataFrame) -> dict:
     }
 
 
-def raw_error(reference: pd.DataFrame, endpoints: pd.DataFrame) -> float:
+def raw_error(reference: pd.DataFrame, endpoints) -> float:
     """Worst distance (deg) from a reference equilibrium to the nearest raw solver endpoint
-    (angles from the real parts of c_i, s_i as the solver returned them, before any refinement)."""
+    (angles from the real parts of c_i, s_i as the solver returned them, before any refinement).
+    `endpoints`: the package's Endpoints table."""
     if len(endpoints) == 0:
         return float("inf")
-    c1, s1, c2, s2 = (endpoints[v].to_numpy(dtype=complex).real for v in ("c1", "s1", "c2", "s2"))
+    frame = endpoints.frame()
+    c1, s1, c2, s2 = (frame[v].to_numpy(dtype=complex).real for v in ("c1", "s1", "c2", "s2"))
     got = np.degrees(np.column_stack([np.arctan2(s1, c1), np.arctan2(s2, c2)])) % 360.0
     ref = reference[["gamma1_deg", "gamma2_deg"]].to_numpy(dtype=float)
     return float(torus_gap(ref, got).min(axis=1).max())
@@ -114,35 +116,24 @@ def run_bertini2(input_text: str, folder: Path, timeout: float = 900.0) -> float
     return seconds
 
 
-def endpoints_from_finite_solutions(folder: Path, variables: tuple[str, ...]) -> pd.DataFrame:
+def endpoints_from_finite_solutions(folder: Path, variables: tuple[str, ...]):
     """Bertini's finite_solutions (user coordinates) as an endpoint table for classify().
 
     For output layouts the package's parser does not read (several homogenising variables of a
     multihomogeneous start; SecurityLevel 1, where main_data also lists the paths at infinity).
     No per-path metadata: condition numbers are left to classify's own Jacobian.
     """
-    from cotm_bertini.backends.parse import METADATA_COLUMNS, read_solution_list
+    from cotm_bertini.backends.endpoints import Endpoints
+    from cotm_bertini.backends.parse import read_solution_list
 
     pts = read_solution_list(folder / "finite_solutions")
     pts = pts.reshape(len(pts), len(variables))
-    n = len(pts)
-    frame = pd.DataFrame(
-        {
-            "path_number": np.arange(n),
-            "condition_number": np.nan,
-            "function_residual": np.nan,
-            "newton_residual": np.nan,
-            "final_t": 0.0,
-            "max_precision": np.nan,
-            "accuracy_estimate": 1e-11,  # Bertini's default final tolerance
-            "cycle_number": 1,
-            "bertini_multiplicity": 1,
-        },
-        columns=list(METADATA_COLUMNS),
-    )
-    for k, v in enumerate(variables):
-        frame[v] = pts[:, k]
-    return frame
+    records = [
+        # accuracy: Bertini's default final tolerance
+        {"path_number": k, "final_t": 0.0, "accuracy_estimate": 1e-11, "coords": p}
+        for k, p in enumerate(pts)
+    ]
+    return Endpoints.from_records(tuple(variables), records)
 
 
 def bertini_seconds_from_files(folder: Path) -> float:

@@ -92,7 +92,7 @@ def force_density(params):
     return numeric_system(variables, names, [e for _, e in eqs], {})
 
 
-def solve_bertini2(system, params, title: str) -> tuple[float, pd.DataFrame]:
+def solve_bertini2(system, params, title: str) -> tuple[float, object]:
     """Total-degree solve by the bertini2 command (default config: MPType 2, seed 1)."""
     from cotm_bertini.backends.parse import read_output
     from cotm_bertini.backends.render import render_input
@@ -109,9 +109,8 @@ def solve_bertini2(system, params, title: str) -> tuple[float, pd.DataFrame]:
 def _cos_sin_residual(params, cs: np.ndarray) -> np.ndarray:
     """Relative residual of the package's cos/sin system at points (c1, s1, c2, s2, d...)."""
     from cotm_bertini.model.compiled import polynomial_system
-    from cotm_bertini.params import normalized
 
-    system = polynomial_system(normalized(params))
+    system = polynomial_system(params.normalized())
     z = cs.copy()
     z[:, 4:] /= params.L3
     size = 1.0 + np.abs(z).max(axis=1)
@@ -142,16 +141,15 @@ def _near_i(x: np.ndarray) -> np.ndarray:
 
 def analyse(case: str, name: str, system, seconds: float, endpoints, params, reference) -> dict:
     """Distinct finite, spurious, artefacts and physical equilibria of one formulation's solve."""
-    from cotm_bertini.model.compiled import polynomial_system
     from cotm_bertini.analysis.classify import classify
     from cotm_bertini.analysis.cluster import cluster_endpoints
+    from cotm_bertini.backends.endpoints import FIELDS, Endpoints
+    from cotm_bertini.model.compiled import polynomial_system
 
     variables = list(system.variables)
-    x = endpoints[variables].to_numpy(dtype=complex)
-    singular = (endpoints["condition_number"].to_numpy() > 1e8) | (
-        endpoints["bertini_multiplicity"].to_numpy() > 1
-    )
-    acc = endpoints["accuracy_estimate"].fillna(1e-11).to_numpy(dtype=float)
+    x = endpoints.points
+    singular = (endpoints.condition_number > 1e8) | (endpoints.bertini_multiplicity > 1)
+    acc = np.nan_to_num(endpoints.accuracy_estimate, nan=1e-11)
     labels = cluster_endpoints(x, singular, acc, 1e-8)
     cs_vars = polynomial_system(params).variables
     # Image in the cos/sin variables (c1, s1, c2, s2, d...).
@@ -169,10 +167,10 @@ def analyse(case: str, name: str, system, seconds: float, endpoints, params, ref
     n = labels.max() + 1 if len(labels) else 0
     spurious_groups = {g for g in range(n) if bad[labels == g].all()}
     keep = np.array([lab not in spurious_groups for lab in labels], dtype=bool)
-    frame = endpoints.loc[keep, [c for c in endpoints.columns if c not in variables]].copy()
-    for k, v in enumerate(cs_vars):
-        frame[v] = cs[keep, k]
-    table = classify(params, frame.reset_index(drop=True), cs_vars)
+    # The same endpoints (metadata kept) mapped into the cos/sin variables.
+    kept = endpoints.select(keep)
+    mapped = Endpoints(tuple(cs_vars), cs[keep], **{f: getattr(kept, f) for f in FIELDS})
+    table = classify(params, mapped)
     phys = table[table["physical"]]
     m = match(reference, phys)
     return {

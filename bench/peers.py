@@ -55,11 +55,11 @@ def cli_end_to_end(repeats: int = REPEATS) -> tuple[list[float], pd.DataFrame]:
     return walls, table
 
 
-def bare_bertini2(params) -> tuple[float, pd.DataFrame]:
+def bare_bertini2(params) -> tuple[float, object]:
     """bertini2 on the total-degree input the package renders (default config)."""
-    from cotm_bertini.model.compiled import polynomial_system
     from cotm_bertini.backends.parse import read_output
     from cotm_bertini.backends.render import render_input
+    from cotm_bertini.model.compiled import polynomial_system
     from cotm_bertini.settings import Settings
 
     text = render_input(polynomial_system(params), Settings(seed=1, engine="cli"), params.as_dict())
@@ -69,10 +69,10 @@ def bare_bertini2(params) -> tuple[float, pd.DataFrame]:
     return seconds, endpoints
 
 
-def phcpack(params) -> tuple[float, pd.DataFrame, str]:
+def phcpack(params) -> tuple[float, object, str]:
     """phc -b through the package's wrapper, timed around the call."""
-    from cotm_bertini.model.compiled import polynomial_system
     from cotm_bertini.backends.phc import solve_phc
+    from cotm_bertini.model.compiled import polynomial_system
 
     system = polynomial_system(params)
     start = time.perf_counter()
@@ -82,14 +82,15 @@ def phcpack(params) -> tuple[float, pd.DataFrame, str]:
     return seconds, res.endpoints, note
 
 
-def zero_dim_solver(params) -> tuple[float, pd.DataFrame, str]:
+def zero_dim_solver(params) -> tuple[float, object, str]:
     """Bertini 2's in-process ab-initio solver on the INPUT section (total degree)."""
     import bertini
     from bertini import nag_algorithm as na
 
-    from cotm_bertini.model.compiled import polynomial_system
-    from cotm_bertini.backends.homotopy import endpoint_row, endpoints_frame
+    from cotm_bertini.backends.endpoints import Endpoints
+    from cotm_bertini.backends.homotopy import endpoint_record
     from cotm_bertini.backends.render import render_system
+    from cotm_bertini.model.compiled import polynomial_system
 
     bertini.recording(False)
     system = polynomial_system(params)
@@ -104,35 +105,34 @@ def zero_dim_solver(params) -> tuple[float, pd.DataFrame, str]:
         for i, m in enumerate(meta)
         if m.is_finite and str(m.endgame_success_code).endswith("Success")
     ]
-    rows = [endpoint_row(i, meta[i], pts[i]) for i in keep]
-    frame = endpoints_frame(system.variables, rows)
-    return seconds, frame, f"{len(meta)} paths, {len(keep)} finite"
+    rows = [endpoint_record(i, meta[i], pts[i]) for i in keep]
+    endpoints = Endpoints.from_records(system.variables, rows)
+    return seconds, endpoints, f"{len(meta)} paths, {len(keep)} finite"
 
 
-def parameter_homotopy(params, repeats: int = REPEATS) -> tuple[list[float], pd.DataFrame, str]:
-    """homotopy.solve_target alone (generic set from the disk cache), median of `repeats`."""
+def parameter_homotopy(params, repeats: int = REPEATS) -> tuple[list[float], object, str]:
+    """target.solve_target alone (generic set from the disk cache), median of `repeats`."""
+    from cotm_bertini.backends.target import solve_target
     from cotm_bertini.model.compiled import parametric_system
-    from cotm_bertini.backends.homotopy import solve_target
 
     ps = parametric_system(params.zfl)
-    solve_target(ps, params, 1)  # warm: generic set loaded (or solved) and bertini imported
+    solve_target(ps, params)  # warm: generic set loaded (or solved) and bertini imported
     walls = []
     for _ in range(repeats):
         start = time.perf_counter()
-        endpoints, info = solve_target(ps, params, 1)
+        solved = solve_target(ps, params)
         walls.append(time.perf_counter() - start)
-    return walls, endpoints, f"{info['tracked']} paths tracked ({info['method']})"
+    info = solved.info
+    return walls, solved.endpoints, f"{info['tracked']} paths tracked ({info['method']})"
 
 
 def run(reference: dict[str, pd.DataFrame] | None = None) -> pd.DataFrame:
     """The peers table: printed, written to peers.csv, returned."""
-    from cotm_bertini.model.compiled import polynomial_system
-    from cotm_bertini.params import make_params
     from cotm_bertini.analysis.classify import classify
+    from cotm_bertini.params import make_params
 
     params = make_params(CASE)
     ref = reference[CASE] if reference else None
-    variables = polynomial_system(params).variables
     rows = []
 
     walls, table = cli_end_to_end()
@@ -148,7 +148,7 @@ def run(reference: dict[str, pd.DataFrame] | None = None) -> pd.DataFrame:
     print(f"  end to end: {median(walls):.2f} s", flush=True)
 
     seconds, endpoints = bare_bertini2(params)
-    table = classify(params, endpoints, variables)
+    table = classify(params, endpoints)
     rows.append(
         {
             "solver": "bare bertini2 (subprocess, total degree)",
@@ -161,13 +161,13 @@ def run(reference: dict[str, pd.DataFrame] | None = None) -> pd.DataFrame:
     print(f"  bertini2: {seconds:.2f} s", flush=True)
 
     seconds, endpoints, note = phcpack(params)
-    table = classify(params, endpoints, variables)
+    table = classify(params, endpoints)
     rows.append({"solver": "PHCpack phc -b", "seconds": seconds, "runs": 1, **_counts(table, ref)})
     rows[-1]["note"] = note
     print(f"  phc: {seconds:.2f} s", flush=True)
 
     seconds, endpoints, note = zero_dim_solver(params)
-    table = classify(params, endpoints, variables)
+    table = classify(params, endpoints)
     rows.append(
         {
             "solver": "Bertini 2 in-process ZeroDimSolver",
@@ -180,7 +180,7 @@ def run(reference: dict[str, pd.DataFrame] | None = None) -> pd.DataFrame:
     print(f"  ZeroDimSolver: {seconds:.2f} s", flush=True)
 
     walls, endpoints, note = parameter_homotopy(params)
-    table = classify(params, endpoints, variables)
+    table = classify(params, endpoints)
     rows.append(
         {
             "solver": "ours, parameter homotopy alone (solve_target)",

@@ -5,52 +5,23 @@
 3. formulations and start systems, cases 2-3                         bench/formulations.py
 4. peers on case 3 (bertini2, PHCpack, Bertini 2 in-process)          bench/peers.py
 5. stage profile of `make case3`                                      bench/stage_profile.py
-6. the paper's 241-point sweep, and a summary of the headline figures
+6. speed side by side: the paper's sweep by four routes, one solve, the 101 x 101 grid
+                                                                     bench/speed.py
+7. a summary of the headline figures
 
 Benchmarks, not tests: nothing is asserted; targets are printed beside the measurements.
 Timings are wall clock on whatever else the machine is doing: run it on a quiet machine.
 
-Usage: .venv/bin/python bench/run_all.py [--quick]   (--quick: the slow case-3 settings skipped)
+Usage: .venv/bin/python bench/run_all.py [--quick]   (--quick: the slow case-3 settings and the
+101 x 101 grid skipped)
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
-import tempfile
 import time
 import traceback
-from pathlib import Path
-
-SWEEP_POINTS = 241
-
-
-def sweep_time(points: int = SWEEP_POINTS) -> dict:
-    """The paper's sweep (L01 0..12 m, L02 = 0, Table 1) as bench/sweep.py runs it, no plots."""
-    from cotm_bertini.params import TABLE1
-    from cotm_bertini.sweep import (
-        SweepSpec,
-        default_workers,
-        prepare,
-        run_points,
-        warm_generic_sets,
-    )
-
-    spec = SweepSpec(dict(TABLE1), "L01", 0.0, 12.0, points)
-    workers = default_workers()
-    start = time.perf_counter()
-    with tempfile.TemporaryDirectory(prefix="bench-sweep-") as tmp:
-        warm_generic_sets(spec)
-        folder = prepare(spec, Path(tmp))
-        stats = run_points(spec, folder, workers=workers)
-    return {
-        "points": stats["solved"],
-        "workers": workers,
-        "sweep_s": stats["seconds"],
-        "wall_s": time.perf_counter() - start,
-        "ms_per_point": 1e3 * stats["seconds"] / max(stats["solved"], 1),
-        "lost_paths": stats["lost_paths"],
-    }
 
 
 def _pareto_settings(grid_table, column: str) -> dict[str, list[str]]:
@@ -80,7 +51,7 @@ def summary(results: dict, failed: list[str], elapsed: float) -> None:
     peers = results.get("peers")
     if peers is not None:
         ours = float(peers.loc[0, "seconds"])
-        add("case-3 end to end (cotm-bertini solve, median of 3)", ours, "s", "< 1 s", ours < 1)
+        add("case-3 end to end (cotm-bertini solve, median of 3)", ours, "s", "< 0.3 s", ours < 0.3)
         for label, key in (("bare bertini2", "bare bertini2"), ("PHCpack phc -b", "PHCpack")):
             row = peers[peers["solver"].str.startswith(key)]
             if len(row):
@@ -103,17 +74,22 @@ def summary(results: dict, failed: list[str], elapsed: float) -> None:
         add("make case3 (with plots) wall", get["wall"], "s")
         add("  of which plots", get["plot"], "s")
         add("  of which start-up and imports", get["startup_import"], "s")
-    sweep = results.get("sweep")
-    if sweep is not None:
-        add(
-            f"{sweep['points']}-point sweep ({sweep['workers']} workers)",
-            sweep["sweep_s"],
-            "s",
-            "< 60 s",
-            sweep["sweep_s"] < 60,
-        )
-        add("  per point", sweep["ms_per_point"], "ms")
-        add("  lost paths", sweep["lost_paths"], "")
+    speed = results.get("speed")
+    if speed is not None:
+        row = speed[(speed["points"] == 241) & speed["route"].str.startswith("ours")].iloc[0]
+        sweep_s = row["seconds"]
+        add("241-point paper sweep (2 workers)", sweep_s, "s", "< 2.5 s", sweep_s < 2.5)
+        add("  per point", row["ms_per_point"], "ms", "< 10 ms", row["ms_per_point"] < 10)
+        add("  worst angle error at the sample points", row["worst_err_deg"], "deg")
+        add("  lost paths", row["lost_paths"], "")
+    solve = results.get("solve")
+    if solve is not None:
+        add("cotm-bertini solve case3 --no-cache --no-plots (median of 5)", solve["median_s"],
+            "s", "< 0.3 s", solve["median_s"] < 0.3)  # fmt: skip
+    grid = results.get("grid101")
+    if grid is not None:
+        add("101 x 101 grid (2 workers)", grid["seconds"], "s", "< 120 s", grid["seconds"] < 120)
+        add("  lost paths", grid["lost_paths"], "")
     add("bench wall time (run_all.py)", elapsed, "s", "< 600 s", elapsed < 600)
     frame = pd.DataFrame(rows)
     show("6. Summary", frame, {"value": ".4g"})
@@ -142,6 +118,7 @@ def main() -> int:
     import peers
     import reference
     import settings_grid
+    import speed
     import stage_profile
 
     results: dict = {}
@@ -170,14 +147,12 @@ def main() -> int:
     section("peers", peers.run, ref)
     section("stages", stage_profile.run)
     section("stages_cli", stage_profile.run, engine="cli")  # what `make case3` runs
-    section("sweep", sweep_time)
-    if "sweep" in results:
-        s = results["sweep"]
-        print(
-            f"\n== sweep: {s['points']} points (L01 0..12 m), {s['workers']} workers: "
-            f"{s['sweep_s']:.2f} s solving ({s['ms_per_point']:.1f} ms per point), "
-            f"{s['wall_s']:.2f} s with set-up; lost paths {s['lost_paths']} =="
-        )
+    section("speed", speed.series, 8)
+    if "speed" in results:
+        speed.plot_series(results["speed"], speed.RESULTS / "speed.png")
+    section("solve", speed.one_solve)
+    if not args.quick:
+        section("grid101", speed.grid)
     summary(results, failed, time.perf_counter() - start)
     print(f"\nbench wall time: {time.perf_counter() - start:.1f} s")
     return 1 if failed else 0

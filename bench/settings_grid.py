@@ -104,20 +104,20 @@ class Outcome:
 
 def _solve_once(params, settings, paths_if_unknown: int) -> tuple[dict, pd.DataFrame, pd.DataFrame]:
     """One timed solve: (measurements, solutions table, raw finite endpoints)."""
-    from cotm_bertini.backends.parse import ParseError
-    from cotm_bertini.pipeline import solve_in
     from cotm_bertini.analysis.classify import classify
+    from cotm_bertini.backends.parse import ParseError
+    from cotm_bertini.point import solve_point
 
     with tempfile.TemporaryDirectory(prefix="bench-grid-") as tmp:
         folder = Path(tmp) / "run"
         start = time.perf_counter()
         try:
-            solved = solve_in(folder, params, settings)
+            solved = solve_point(params, settings, folder=folder)
         except ParseError as exc:
             # Read what Bertini wrote, as the pipeline would have; classify with the package.
             variables = _variables(params)
             endpoints = endpoints_from_finite_solutions(folder, variables)
-            table = classify(params, endpoints, variables)
+            table = classify(params, endpoints)
             wall = time.perf_counter() - start
             note = f"pipeline ParseError: {str(exc).split(': ', 1)[-1]}"
             info = {
@@ -130,16 +130,16 @@ def _solve_once(params, settings, paths_if_unknown: int) -> tuple[dict, pd.DataF
             }
             return info, table, endpoints
         wall = time.perf_counter() - start
-    method = solved.details.get("homotopy", {}).get("method")
+    homotopy = solved.details.get("homotopy")
     info = {
         "wall_s": wall,
-        "bertini_s": solved.bertini_seconds,
-        "paths": solved.paths_tracked,
-        "finite_endpoints": len(solved.output.endpoints),
+        "bertini_s": homotopy["seconds"] if homotopy else solved.details["bertini_seconds"],
+        "paths": solved.counts["paths_tracked"],
+        "finite_endpoints": solved.counts["finite_endpoints"],
         "status": "ok",
-        "note": method or "",
+        "note": homotopy["method"] if homotopy else "",
     }
-    return info, solved.solutions, solved.output.endpoints
+    return info, solved.table, solved.endpoints
 
 
 def _variables(params) -> tuple[str, ...]:
@@ -150,8 +150,8 @@ def _variables(params) -> tuple[str, ...]:
 
 def _paths(params, settings) -> int:
     """Paths Bertini tracks for a CLI solve: total degree, or the multihomogeneous Bezout number."""
-    from cotm_bertini.model.compiled import polynomial_system
     from cotm_bertini.backends.render import variable_groups
+    from cotm_bertini.model.compiled import polynomial_system
 
     system = polynomial_system(params)
     return multihomogeneous_bezout(system, variable_groups(system, settings))
@@ -195,16 +195,16 @@ def measure(case: str, point: Point, reference: pd.DataFrame, repeats: int = 3) 
 def warm_up() -> pd.DataFrame:
     """First solves of the process (imports, engine start, generic sets): timed, not graded."""
     from cotm_bertini.params import make_params
-    from cotm_bertini.pipeline import solve
+    from cotm_bertini.point import solve_point
     from cotm_bertini.settings import Settings
 
     rows = []
     for case in CASES:
         start = time.perf_counter()
-        solve(make_params(case), Settings(seed=1))
+        solve_point(make_params(case), Settings(seed=1))
         rows.append({"case": case, "first_solve_s": time.perf_counter() - start})
     start = time.perf_counter()
-    solve(make_params("case1"), Settings(seed=1, engine="cli"))
+    solve_point(make_params("case1"), Settings(seed=1, engine="cli"))
     rows.append({"case": "case1 (cli)", "first_solve_s": time.perf_counter() - start})
     return pd.DataFrame(rows)
 

@@ -1,0 +1,319 @@
+"""Speed side by side (issue 9): the paper's L01 sweep by four routes, a 2-D grid, one solve.
+
+1. The same work -- every equilibrium at N points of the paper's sweep (L01 from 0 to 12 m,
+   L02 = 0, Table 1) -- by four routes: ours (`cb.sweep`, 2 workers, points continued from their
+   neighbours), the bare `bertini2` command per point (total degree), Bertini 2 in-process ab
+   initio (`ZeroDimSolver`) per point, and PHCpack `phc -b` per point. Ours is run at every N;
+   the three peers cost ~0.2-1 s a point, so they are timed on a sample of points and their
+   time for N points is N times the sample mean (marked `sampled`). Beside every time: the paths
+   tracked per point, the cost per path, and the worst angle error of the physical equilibria at
+   the sample points against 40-digit Newton (bench/reference.py's method), misses counted.
+2. The 101 x 101 (L01, L02) grid over (0, 12] x (0, 12] with 2 workers (`--grid`).
+3. One solve end to end: `cotm-bertini solve case3 --no-cache --no-plots` as a subprocess,
+   median of 5, with the import times of its heavy modules (python -X importtime).
+4. `--profile`: cProfile of continued sweep points (the top functions).
+
+Benchmarks, not tests: nothing is asserted; targets are printed beside the measurements.
+Usage: .venv/bin/python bench/speed.py [--grid] [--profile] [--sample 8]
+"""
+
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from benchlib import RESULTS, match, median, run_bertini2, show, write_csv
+
+SERIES = (1, 10, 30, 100, 241)
+TARGET_SWEEP_S = 2.5
+TARGET_GRID_S = 120.0
+TARGET_SOLVE_S = 0.3
+
+
+def sweep_values(n: int) -> np.ndarray:
+    """The paper's sweep at n points."""
+    return np.linspace(0.0, 12.0, n)
+
+
+def reference_at(values: np.ndarray) -> dict[float, pd.DataFrame]:
+    """40-digit physical equilibria at each L01 (energy route starts, mpmath Newton)."""
+    from reference import newton_mp
+
+    from cotm_bertini.analysis.critical_points import critical_points
+    from cotm_bertini.params import Params
+
+    out = {}
+    for v in values:
+        params = Params(L01=float(v))
+        rows = [newton_mp(params, c.gamma1_deg, c.gamma2_deg) for c in
+                critical_points(params).itertuples(index=False)]  # fmt: skip
+        out[float(v)] = pd.DataFrame(rows)
+    return out
+
+
+def ours(n: int, workers: int = 2) -> dict:
+    """cb.sweep over n points in a fresh folder: seconds, methods, the table."""
+    import cotm_bertini as cb
+
+    with tempfile.TemporaryDirectory(prefix="bench-speed-") as tmp:
+        start = time.perf_counter()
+        sw = cb.sweep(cb.Params(), "L01", sweep_values(n), workers=workers, out=tmp)
+        wall = time.perf_counter() - start
+        table = sw.table
+        record = sw.record
+    firsts = table.groupby("point")["method"].first()
+    return {
+        "seconds": record["stats"]["seconds"],
+        "wall": wall,
+        "table": table,
+        "lost": record["lost_paths"],
+        "methods": firsts.str.split(" \\(").str[0].value_counts().to_dict(),
+    }
+
+
+def _classified(params, endpoints) -> pd.DataFrame:
+    from cotm_bertini.analysis.classify import classify
+
+    return classify(params, endpoints)
+
+
+def bare_bertini2(value: float) -> tuple[float, pd.DataFrame, int]:
+    """The bertini2 command on the total-degree input of one point."""
+    from cotm_bertini.backends.parse import read_output
+    from cotm_bertini.backends.render import render_input
+    from cotm_bertini.model.compiled import polynomial_system
+    from cotm_bertini.params import Params
+    from cotm_bertini.settings import Settings
+
+    params = Params(L01=value)
+    system = polynomial_system(params)
+    text = render_input(system, Settings(seed=1, engine="cli"), params.as_dict())
+    with tempfile.TemporaryDirectory(prefix="bench-bare-") as tmp:
+        seconds = run_bertini2(text, Path(tmp) / "run")
+        endpoints = read_output(Path(tmp) / "run").endpoints
+    return seconds, _classified(params, endpoints), system.total_degree
+
+
+def in_process_ab_initio(value: float) -> tuple[float, pd.DataFrame, int]:
+    """Bertini 2's ZeroDimSolver (total degree) on one point, in process."""
+    from cotm_bertini.backends.homotopy import ab_initio
+    from cotm_bertini.model.compiled import parametric_system, polynomial_system
+    from cotm_bertini.params import Params
+    from cotm_bertini.settings import Settings
+
+    params = Params(L01=value)
+    ps = parametric_system(params.zfl)
+    start = time.perf_counter()
+    endpoints, _lost = ab_initio(ps, params, Settings(seed=1))
+    seconds = time.perf_counter() - start
+    return seconds, _classified(params, endpoints), polynomial_system(params).total_degree
+
+
+def phcpack(value: float) -> tuple[float, pd.DataFrame, int]:
+    """phc -b on one point (seed 1)."""
+    from cotm_bertini.backends.phc import solve_phc
+    from cotm_bertini.model.compiled import polynomial_system
+    from cotm_bertini.params import Params
+
+    params = Params(L01=value)
+    start = time.perf_counter()
+    res = solve_phc(polynomial_system(params), seed=1)
+    seconds = time.perf_counter() - start
+    return seconds, _classified(params, res.endpoints), res.root_count
+
+
+def _errors(tables: dict[float, pd.DataFrame], ref: dict[float, pd.DataFrame]) -> tuple:
+    worst, missed = 0.0, 0
+    for v, table in tables.items():
+        m = match(ref[v], table[table["physical"].astype(bool)])
+        worst, missed = max(worst, m["worst_err_deg"]), missed + m["missed"]
+    return worst, missed
+
+
+PEERS = {
+    "bare bertini2 (subprocess, total degree)": bare_bertini2,
+    "Bertini 2 in-process ab initio (ZeroDimSolver)": in_process_ab_initio,
+    "PHCpack phc -b": phcpack,
+}
+
+
+def peer_sample(route, sample: np.ndarray) -> dict:
+    """Time one peer route on the sample points: mean seconds a point, paths, tables."""
+    seconds, tables, paths = [], {}, 0
+    for v in sample:
+        s, table, paths = route(float(v))
+        seconds.append(s)
+        tables[float(v)] = table
+    return {"per_point": float(np.mean(seconds)), "paths": paths, "tables": tables}
+
+
+def series(sample_size: int) -> pd.DataFrame:
+    """Section 1: every route at every N, with errors on the sample points."""
+    sample = sweep_values(241)[np.linspace(5, 235, sample_size).astype(int)]
+    ref = reference_at(sample)
+    ours(10)  # warm: generic sets solved or loaded, worker start-up paid once
+    rows = []
+    for n in SERIES:
+        run = ours(n)
+        at = {v: g for v, g in run["table"].groupby("L01")}
+        tables = {float(v): at[v] for v in sample if n == 241 and v in at}
+        worst, missed = _errors(tables, ref) if tables else (np.nan, np.nan)
+        rows.append(_row("ours: cb.sweep, 2 workers, continued points", n, run["seconds"],
+                         20, worst, missed, "measured", run["methods"], run["lost"]))  # fmt: skip
+        print(f"  ours {n:4d} points: {run['seconds']:.2f} s", flush=True)
+    for name, route in PEERS.items():
+        got = peer_sample(route, sample)
+        worst, missed = _errors(got["tables"], ref)
+        for n in SERIES:
+            rows.append(_row(name, n, n * got["per_point"], got["paths"], worst, missed,
+                             f"sampled ({len(sample)} points)", {}, 0))  # fmt: skip
+        print(f"  {name}: {got['per_point'] * 1e3:.0f} ms a point", flush=True)
+    return pd.DataFrame(rows)
+
+
+def _row(route, n, seconds, paths, worst, missed, how, methods, lost) -> dict:
+    return {
+        "route": route,
+        "points": n,
+        "seconds": seconds,
+        "ms_per_point": 1e3 * seconds / n,
+        "paths_per_point": paths,
+        "us_per_path": 1e6 * seconds / n / paths,
+        "worst_err_deg": worst,
+        "missed": missed,
+        "lost_paths": lost,
+        "timing": how,
+        "methods": "; ".join(f"{k}: {v}" for k, v in methods.items()),
+    }
+
+
+def plot_series(table: pd.DataFrame, path: Path) -> None:
+    """Time per point against the number of points, one line per route (log-log)."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(8, 5.5), layout="constrained")
+    ax = fig.subplots()
+    for route, group in table.groupby("route", sort=False):
+        style = "-o" if route.startswith("ours") else "--s"
+        ax.plot(group["points"], group["ms_per_point"], style, label=route)
+    ax.axhline(1e3 * TARGET_SWEEP_S / 241, color="grey", lw=0.8, ls=":",
+               label=f"target: 241 points in {TARGET_SWEEP_S} s")  # fmt: skip
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("points of the paper's L01 sweep")
+    ax.set_ylabel("wall time per point (ms)")
+    ax.set_title("Every equilibrium at N points: time per point by route (2 cores)")
+    ax.legend(fontsize=8)
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    print(f"-> {path.relative_to(RESULTS.parent.parent)}")
+
+
+def grid(n: int = 101) -> dict:
+    """Section 2: the n x n (L01, L02) grid over (0, 12] x (0, 12], 2 workers."""
+    import cotm_bertini as cb
+
+    values = np.linspace(12.0 / n, 12.0, n)
+    with tempfile.TemporaryDirectory(prefix="bench-grid-") as tmp:
+        sw = cb.sweep(cb.Params(), "L01", values, param2="L02", values2=values, workers=2,
+                      out=tmp)  # fmt: skip
+        firsts = sw.table.groupby("point")["method"].first()
+        record = sw.record
+    methods = firsts.str.split(" \\(").str[0].value_counts().to_dict()
+    out = {
+        "points": n * n,
+        "seconds": record["stats"]["seconds"],
+        "ms_per_point": 1e3 * record["stats"]["seconds"] / (n * n),
+        "lost_paths": record["lost_paths"],
+        "status": record["status"],
+        **{f"method: {k}": v for k, v in methods.items()},
+    }
+    show(f"2. {n} x {n} grid over (L01, L02), 2 workers (target {TARGET_GRID_S:.0f} s)",
+         pd.DataFrame([out]).T.reset_index().set_axis(["what", "value"], axis=1))  # fmt: skip
+    return out
+
+
+def one_solve(repeats: int = 5) -> dict:
+    """Section 3: `cotm-bertini solve case3 --no-cache --no-plots`, median wall, import times."""
+    exe = str(Path(sys.executable).with_name("cotm-bertini"))
+    walls = []
+    with tempfile.TemporaryDirectory(prefix="bench-solve-") as tmp:
+        cmd = [exe, "solve", "case3", "--no-cache", "--no-plots", "--quiet", "--out", tmp]
+        subprocess.run(cmd, capture_output=True, check=True)  # warm caches
+        for _ in range(repeats):
+            start = time.perf_counter()
+            subprocess.run(cmd, capture_output=True, check=True)
+            walls.append(time.perf_counter() - start)
+        trace = subprocess.run(
+            [sys.executable, "-X", "importtime", "-m", "cotm_bertini.cli", *cmd[1:]],
+            capture_output=True, text=True, check=True,
+        ).stderr  # fmt: skip
+    imports = _import_times(trace, ("numpy", "bertini", "jinja2", "cotm_bertini.point"))
+    start = time.perf_counter()
+    subprocess.run([sys.executable, "-c", "pass"], check=True)
+    bare = time.perf_counter() - start
+    out = {"median_s": median(walls), "runs": ", ".join(f"{w:.3f}" for w in walls),
+           "python -c pass": bare, **imports}  # fmt: skip
+    show(f"3. cotm-bertini solve case3 --no-cache --no-plots (target {TARGET_SOLVE_S} s)",
+         pd.DataFrame([out]).T.reset_index().set_axis(["what", "value"], axis=1))  # fmt: skip
+    return out
+
+
+def _import_times(trace: str, names: tuple[str, ...]) -> dict[str, float]:
+    """Cumulative import seconds of the named top-level modules from python -X importtime."""
+    out = {}
+    for line in trace.splitlines():
+        parts = [p.strip() for p in line.removeprefix("import time:").split("|")]
+        if len(parts) == 3 and parts[2] in names:
+            out[f"import {parts[2]} (s)"] = int(parts[1]) / 1e6
+    return out
+
+
+def profile_points(n: int = 101) -> None:
+    """Section 4: cProfile of n continued points of the paper's sweep (one process)."""
+    import cProfile
+    import pstats
+
+    from cotm_bertini.params import Params
+    from cotm_bertini.point import solve_point
+    from cotm_bertini.settings import Settings
+
+    settings = Settings(threads=1)
+    warm = solve_point(Params(L01=0.5), settings).warm
+    prof = cProfile.Profile()
+    prof.enable()
+    for v in np.linspace(0.6, 12.0, n):
+        warm = solve_point(Params(L01=float(v)), settings, warm=warm).warm
+    prof.disable()
+    print(f"\n== 4. Profile of {n} continued points (one process, one thread) ==")
+    pstats.Stats(prof).sort_stats("tottime").print_stats(15)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--grid", action="store_true", help="also the 101 x 101 grid (~2 min)")
+    ap.add_argument("--profile", action="store_true", help="also a profile of sweep points")
+    ap.add_argument("--sample", type=int, default=8, help="points timed for the peers")
+    args = ap.parse_args()
+    table = series(args.sample)
+    show("1. The paper's sweep by four routes (2 cores)", table.drop(columns=["methods"]),
+         {"seconds": ".3g", "ms_per_point": ".3g", "us_per_path": ".0f",
+          "worst_err_deg": ".1e"})  # fmt: skip
+    print("ours, methods at 241 points: " + table.loc[table["points"] == 241, "methods"].iloc[0])
+    write_csv(table, "speed")
+    plot_series(table, RESULTS / "speed.png")
+    one_solve()
+    if args.grid:
+        grid()
+    if args.profile:
+        profile_points()
+
+
+if __name__ == "__main__":
+    main()

@@ -71,7 +71,7 @@ def summary(results: dict, failed: list[str], elapsed: float) -> None:
     stages = results.get("stages")
     if stages is not None:
         get = dict(zip(stages["stage"], stages["median_s"], strict=True))
-        add("make case3 (with plots) wall", get["wall"], "s")
+        add("cotm-bertini solve case3 --no-cache (with plots) wall", get["wall"], "s")
         add("  of which plots", get["plot"], "s")
         add("  of which start-up and imports", get["startup_import"], "s")
     speed = results.get("speed")

@@ -14,11 +14,12 @@ from ..fs import timestamp, write_json
 from ..io import cache
 from ..io.runfolder import (
     RUN_JSON,
-    copy_run,
     figure_files,
+    finish_copy,
     read_record,
     read_solutions,
     solve_record,
+    start_copy,
     write_solution_files,
 )
 from ..params import Params
@@ -119,29 +120,25 @@ class Solutions:
         """Write the run folder: solutions.csv, run.json, columns.md, input, solver files and,
         with `plots`, configurations.* and energy_map.*; built under a hidden name, then renamed.
         """
-        update = {"created": timestamp(), "command": command, "cache": self.record.get("cache")}
-        dest = copy_run(self.folder, Path(folder), update, with_figures=plots)
-        if plots and not figure_files(dest):
-            drawn = _draw(self.params, self.table, dest)
+        start = time.perf_counter()
+        dest = Path(folder)
+        work = start_copy(self.folder, dest, with_figures=plots)
+        record = read_record(work)
+        record.update(created=timestamp(), command=command, cache=self.record.get("cache"))
+        timings = dict(record.get("timings", {}))
+        if plots and not figure_files(work):
+            t0 = time.perf_counter()
+            from ..plot.run import plot_run  # matplotlib only when pictures are asked for
+
+            drawn = plot_run(self.params, self.table, work)
+            timings["plot"] = time.perf_counter() - t0
             key = self.record.get("cache_key")
             if key and self.folder == cache.entry(key):
                 cache.add_files(key, drawn)  # the next identical request finds them
-        names = [p.name for p in figure_files(dest)] if plots else []
-        _update_record(dest, {"figures": names})
-        return dest
-
-
-def _draw(params: Params, table, folder: Path) -> list[Path]:
-    from ..plot.run import plot_run  # matplotlib only when pictures are asked for
-
-    start = time.perf_counter()
-    paths = plot_run(params, table, folder)
-    _update_record(folder, {"plot_seconds": time.perf_counter() - start})
-    return paths
-
-
-def _update_record(folder: Path, fields: dict) -> None:
-    write_json(folder / RUN_JSON, read_record(folder) | fields)
+        record["figures"] = [p.name for p in figure_files(work)] if plots else []
+        timings["save"] = time.perf_counter() - start
+        record["timings"] = timings
+        return finish_copy(work, dest, record)
 
 
 def solve(

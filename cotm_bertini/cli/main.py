@@ -89,7 +89,7 @@ def _parser() -> argparse.ArgumentParser:
     pp.add_argument("--seed", type=int, default=1, help="solver seed (default 1)")
     pp.set_defaults(run=commands.paper)
     pr = sub.add_parser("params", help="print the parameters (Table 1 and a case preset)")
-    add_case(pr)
+    add_case(pr, default="none: Table 1 as printed (L01 = L02 = 0)")
     add_params(pr)
     pr.set_defaults(run=commands.params)
     return ap

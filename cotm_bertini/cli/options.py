@@ -27,14 +27,14 @@ class Parser(argparse.ArgumentParser):
 DEFAULT_CASE = "case3"
 
 
-def add_case(p: argparse.ArgumentParser) -> None:
+def add_case(p: argparse.ArgumentParser, default: str = DEFAULT_CASE) -> None:
     """The positional case preset."""
     p.add_argument(
         "case",
         nargs="?",
         choices=sorted(CASES),
         help="preset for L01/L02 (case1: 0, 0; case2: 11.5, 0; case3: 11.5, 11.5); "
-        f"default {DEFAULT_CASE}",
+        f"default {default}",
     )
 
 

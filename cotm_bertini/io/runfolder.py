@@ -120,15 +120,20 @@ def figure_files(folder: Path) -> list[Path]:
     return sorted(p for p in Path(folder).iterdir() if p.stem in FIGURE_STEMS and p.is_file())
 
 
-def copy_run(source: Path, dest: Path, update: dict, with_figures: bool) -> Path:
-    """A new run folder `dest` with the files of `source` and run.json updated; atomic."""
+def start_copy(source: Path, dest: Path, with_figures: bool) -> Path:
+    """Copy a run folder's files into the hidden working folder of `dest` (which must not exist,
+    or be an empty folder); `finish_copy` renames it into place."""
     dest = Path(dest)
     if dest.exists() and (not dest.is_dir() or any(dest.iterdir())):
         raise ParameterError(f"save {str(dest)!r}: exists and is not an empty folder")
     work = partial_name(dest)
     skip = set() if with_figures else {p.name for p in figure_files(source)}
     shutil.copytree(source, work, ignore=lambda _d, names: [n for n in names if n in skip])
-    record = read_record(work) | update
+    return work
+
+
+def finish_copy(work: Path, dest: Path, record: dict) -> Path:
+    """Write run.json into the working folder and rename it to `dest`: complete or absent."""
     write_json(work / RUN_JSON, record)
     if dest.exists():
         dest.rmdir()

@@ -9,12 +9,12 @@ from pathlib import Path
 from ..api.solutions import solve
 from ..fs import atomic_write_text, write_csv
 from ..params import TABLE1, make_params
-from .report import Scenario, build_report
+from .report import Scenario, build_report, verdict
 from .tables import K_RATIO
 
 
 def compare_with_paper(out: Path, seed: int = 1) -> str:
-    """Write report.md and rows.csv into `out`; returns the report's one-line verdict."""
+    """Write report.md and rows.csv into `out`; returns the one-line verdict and the files."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     scenarios = []
@@ -33,4 +33,4 @@ def compare_with_paper(out: Path, seed: int = 1) -> str:
     text, rows = build_report(scenarios)
     atomic_write_text(out / "report.md", text)
     write_csv(out / "rows.csv", rows)
-    return f"report: {out / 'report.md'}, rows: {out / 'rows.csv'}"
+    return f"{verdict(rows, scenarios)}\nreport: {out / 'report.md'}, rows: {out / 'rows.csv'}"

@@ -11,7 +11,7 @@ import pandas as pd
 from ..analysis.morse import zero_length_configurations
 from ..model.compiled import polynomial_system, tan_half_jacobian
 from ..params import Params
-from .tables import TABLES, PaperTable
+from .tables import K_RATIO, TABLES, PaperTable
 
 MATCH_DEG = 1.0  # a printed row within this of one of ours is that solution
 D_WEIGHT = 10.0  # degrees per metre of printed spring length, in the row distance
@@ -231,6 +231,8 @@ def build_report(scenarios: list[Scenario]) -> tuple[str, pd.DataFrame]:
     csv = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
     if len(scenarios) > 1:
         lines += _changes(csv, scenarios)
+    lines += _explanations(csv, scenarios)
+    lines += ["## Verdict", "", verdict(csv, scenarios), ""]
     return "\n".join(lines) + "\n", csv
 
 
@@ -251,6 +253,60 @@ def _changes(csv: pd.DataFrame, scenarios: list[Scenario]) -> list[str]:
             f"{pb.median():.4f} deg; rows whose category changes: {changed or 'none'}."
         )
     return out + [""]
+
+
+def _explanations(csv: pd.DataFrame, scenarios: list[Scenario]) -> list[str]:
+    """Why our counts differ from the paper's, and what the spring-constant ratio does to case 1."""
+    out = ["## Explanations", ""]
+    s = scenarios[0].solutions.get("case3")
+    if s is not None:
+        double = int(s["singular"].astype(bool).sum())
+        table4 = next(t for t in TABLES if t.case == "case3")
+        out.append(
+            f"- **Table 4: {table4.total_solutions} solutions in the paper, {len(s)} here.** "
+            f"Both have {table4.real_solutions} real ones (here {int(s['is_real'].sum())}). "
+            f"Of our {len(s)} distinct finite solutions {double} are double roots (a spring "
+            "with L0 > 0 at zero length: singular, each reached by two paths of a total-degree "
+            f"homotopy), so a total-degree solve ends {len(s) + double} paths at finite points, "
+            "as Bertini 1.6 reports. The paper does not state its formulation or how it counts; "
+            f"{table4.total_solutions} is neither number, and no formulation we tried gives it "
+            "(docs/benchmarks.md: total degree 76, multihomogeneous 77, the tan-half form 200 "
+            "finite of which 124 spurious at x = +-i, force density 62)."
+        )
+    if len(scenarios) > 1:
+        dist = {}
+        for sc in scenarios[:2]:
+            rows = csv[(csv["scenario"] == sc.name) & (csv["table"] == "Table 2")]
+            dist[sc.name] = rows.loc[rows["category"] == "physical equilibrium", "distance"]
+        a, b = (dist[sc.name] for sc in scenarios[:2])
+        if len(a) and len(b):
+            out.append(
+                f"- **Case 1 and the ratio k2/k1.** Table 2 is reproduced with the printed ratio "
+                f"(largest distance {a.max():.4f} deg over {len(a)} physical rows); with "
+                f"k2/k1 = {K_RATIO} it is not (largest distance {b.max():.4f} deg). The "
+                "ratio that reproduces Tables 3 and 4 does not apply to Table 2: the paper's "
+                "cases were apparently not solved with one set of spring constants."
+            )
+    return out + [""]
+
+
+def verdict(csv: pd.DataFrame, scenarios: list[Scenario]) -> str:
+    """One line: which tables are reproduced, under which ratio, to what distance."""
+    parts = []
+    for table in TABLES:
+        best = None
+        for sc in scenarios:
+            rows = csv[(csv["scenario"] == sc.name) & (csv["table"] == table.name)]
+            phys = rows[rows["category"] == "physical equilibrium"]
+            unmatched = int((rows["category"] == "unmatched").sum())
+            if len(phys) and (best is None or phys["distance"].max() < best[1]):
+                best = (sc.name, float(phys["distance"].max()), len(phys), unmatched)
+        if best is not None:
+            parts.append(
+                f"{table.name}: {best[2]} physical rows within {best[1]:.4f} deg with "
+                f"{best[0]}" + (f", {best[3]} unmatched" if best[3] else "")
+            )
+    return "paper: " + "; ".join(parts)
 
 
 def _markdown_table(m: pd.DataFrame) -> str:

@@ -75,9 +75,26 @@ def _cut_at_edges(a: np.ndarray, b: np.ndarray) -> list[tuple[np.ndarray, np.nda
 
 
 def _branch_colours(branches: list) -> dict:
-    """A colour per branch id, cycling through tab10 without its grey (kept for non-physical)."""
-    palette = [c for k, c in enumerate(matplotlib.colormaps["tab10"].colors) if k != 7]
+    """A colour per branch id: tab20 without its greys (kept for non-physical), 18 colours, so
+    the branches of a sweep (a handful of physical ones) do not share one."""
+    palette = [c for k, c in enumerate(matplotlib.colormaps["tab20"].colors) if k not in (14, 15)]
     return {b: palette[k % len(palette)] for k, b in enumerate(branches)}
+
+
+def _physical_events(events: pd.DataFrame, sweep: pd.DataFrame, param: str) -> pd.DataFrame:
+    """The events that happen on physical branches: a fold of two negative-d roots has no place
+    on a plot of the physical equilibria. Events without branch ids are all kept."""
+    if "branches" not in events or "branch" not in sweep:
+        return events
+    at = "value" if "value" in events else param
+    keep = []
+    for ev in events.itertuples(index=False):
+        ev = ev._asdict()
+        ids = [int(b) for b in str(ev["branches"]).split("+") if b.strip().lstrip("-").isdigit()]
+        lo, hi = ev.get("lo", ev[at]), ev.get("hi", ev[at])
+        rows = sweep[sweep["branch"].isin(ids) & sweep[param].between(lo, hi)]
+        keep.append(bool(flag(rows, "physical").any()))
+    return events[np.array(keep, dtype=bool)]
 
 
 def _styled_rows(sweep: pd.DataFrame, show_all: bool) -> pd.DataFrame:
@@ -227,6 +244,8 @@ def bifurcation_figure(
     `value`, or else `param` itself.
     """
     rows = _styled_rows(sweep, show_all)
+    if events is not None and len(events) and not show_all:
+        events = _physical_events(events, sweep, param)
     values = np.unique(sweep[param].to_numpy(dtype=float))
     rank_of = {v: k for k, v in enumerate(values)}
     has_branches = "branch" in rows and len(rows) > 0
@@ -255,15 +274,25 @@ def bifurcation_figure(
         axes[1].set_xlim(values[0] - pad, values[-1] + pad)
     axes[1].set_xlabel(param_label(param))
     _legend(fig, has_branches, dense, show_all, events)
-    n_points = sweep["point"].nunique() if "point" in sweep else len(values)
-    lines_note = "colours: branches" if has_branches else "no branch column: samples only"
-    fig.suptitle(
-        f"Equilibria of the CoTM against {param}: {n_points} points, "
-        f"{int(flag(sweep, 'physical').sum())} physical rows, "
-        f"{int(flag(sweep, 'stable').sum())} stable ({lines_note})",
-        fontsize=10,
-    )
+    fig.suptitle(_title(sweep, param, values, has_branches), fontsize=10)
     return fig
+
+
+def _title(sweep: pd.DataFrame, param: str, values: np.ndarray, has_branches: bool) -> str:
+    """What a reader needs: the points, and how many equilibria (stable ones) a point has."""
+    key = "point" if "point" in sweep else param
+    per = sweep.assign(_p=flag(sweep, "physical"), _s=flag(sweep, "stable")).groupby(key)
+    phys, stable = per["_p"].sum(), per["_s"].sum()
+
+    def span(counts) -> str:
+        lo, hi = int(counts.min()), int(counts.max())
+        return f"{lo}" if lo == hi else f"{lo} to {hi}"
+
+    note = "colours: branches" if has_branches else "no branch column: samples only"
+    return (
+        f"Equilibria of the CoTM against {param} ({len(values)} values): "
+        f"{span(phys)} physical equilibria a point, {span(stable)} of them stable ({note})"
+    )
 
 
 def plot_bifurcation(

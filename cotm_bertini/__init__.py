@@ -23,6 +23,8 @@ _EXPORTS = {
     "Sweep": "cotm_bertini.api.sweeps",
     "sweep": "cotm_bertini.api.sweeps",
     "resume_sweep": "cotm_bertini.api.sweeps",
+    "certify": "cotm_bertini.api.certificates",
+    "CertificateError": "cotm_bertini.errors",
     "CotmError": "cotm_bertini.errors",
     "ParameterError": "cotm_bertini.errors",
     "SolverError": "cotm_bertini.errors",

@@ -40,6 +40,11 @@ SOLUTIONS = {
     "paths": "the path numbers that ended at this solution (-1: computed in closed form)",
     "<var>_re, <var>_im": "the solver's variables (c1, s1, c2, s2, and d1, d2 where a spring has "
     "L0 > 0) as computed",
+    "certified": "after `--certify` / cb.certify only: a unique solution of the polynomial system "
+    "is proved (Krawczyk, ball arithmetic) in the box around this row, real if the row is real, "
+    "non-real if not; singular rows (double roots) cannot be",
+    "certified_radius": "after `--certify` only: the half-width of that box in every variable, in "
+    "units of L3 for d (NaN where not certified)",
 }
 
 SWEEP = {
@@ -49,7 +54,10 @@ SWEEP = {
     "method": "how the point was solved: parameter homotopy (+ adaptive retrack), second start, "
     "ab initio, or the cli engine",
     "lost_paths": "paths that failed at this point (empty where the engine does not say)",
-    "status": "ok, or incomplete when the point's Morse count failed or a path was lost",
+    "status": "ok, or incomplete when the point's Morse count failed, a path was lost, or (with "
+    "--certify) its proof was not complete",
+    "certificate, certify_seconds": "with --certify: the point's certificate status (proved, "
+    "undecided, contradiction) and what it cost",
     "branch": "1-D sweeps: which branch the row belongs to (secant prediction + one-to-one "
     "assignment over all finite solutions, so branches continue through folds)",
 }

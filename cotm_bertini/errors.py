@@ -21,3 +21,13 @@ class EngineError(SolverError):
 
 class IncompleteError(CotmError, RuntimeError):
     """A completeness check failed: equilibria may be missing (the result is kept, not trusted)."""
+
+
+class CertificateError(CotmError, RuntimeError):
+    """The proof and the solver's table differ: an equilibrium missing, unproved, or mislabelled.
+
+    `certificate` holds the whole certificate (what was proved, and every difference)."""
+
+    def __init__(self, message: str, certificate=None) -> None:
+        super().__init__(message)
+        self.certificate = certificate

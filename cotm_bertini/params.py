@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import asdict, dataclass, fields
+from dataclasses import dataclass, fields
 from pathlib import Path
 
 from .errors import ParameterError
@@ -95,7 +95,7 @@ class Params:
 
     def as_dict(self) -> dict[str, float]:
         """Parameters as a plain dict, in PARAM_NAMES order."""
-        return asdict(self)
+        return {name: getattr(self, name) for name in PARAM_NAMES}
 
     def replace(self, **values: float) -> Params:
         """A copy with some values replaced, validated like the command line."""

@@ -10,10 +10,11 @@ from dataclasses import asdict, fields
 from pathlib import Path
 
 from ..errors import CotmError, ParameterError
-from ..fs import timestamp, write_json
+from ..fs import timestamp, write_csv, write_json
 from ..io import cache
 from ..io.runfolder import (
     RUN_JSON,
+    SOLUTIONS_CSV,
     figure_files,
     finish_copy,
     read_record,
@@ -44,6 +45,7 @@ class Solutions:
         self.folder = Path(folder)  # holds solutions.csv, run.json, input and solver files
         self._columns = columns  # a fresh solve's numpy columns (the table is built from them)
         self._table = None
+        self.certificate = None  # set by cb.certify
 
     def __repr__(self) -> str:
         c = self.counts
@@ -63,6 +65,13 @@ class Solutions:
             else:
                 self._table = read_solutions(self.folder)
         return self._table
+
+    def attach_certificate(self, cert) -> None:
+        """Keep a certificate: the table gains `certified` and `certified_radius`."""
+        self.certificate = cert
+        self._table = self.table.assign(
+            certified=cert.certified, certified_radius=cert.certified_radius
+        )
 
     @property
     def real(self):
@@ -136,6 +145,10 @@ class Solutions:
             if key and self.folder == cache.entry(key):
                 cache.add_files(key, drawn)  # the next identical request finds them
         record["figures"] = [p.name for p in figure_files(work)] if plots else []
+        if self.certificate is not None:
+            write_csv(work / SOLUTIONS_CSV, self.table)
+            record["certificate"] = self.certificate.record()
+            record["status"] = _status_with(record["status"], self.certificate.status)
         timings["save"] = time.perf_counter() - start
         record["timings"] = timings
         return finish_copy(work, dest, record)
@@ -231,3 +244,12 @@ def _tolerances(tolerances: Tolerances | dict | None) -> dict:
                 raise ParameterError(f"{name}: unknown tolerance (known: {' '.join(known)})")
         tolerances = Tolerances(**tolerances)
     return asdict(tolerances)
+
+
+def _status_with(status: str, certificate: str) -> str:
+    """A run's status once certified: a contradiction or an undecided proof overrides ok."""
+    if certificate == "contradiction":
+        return "contradiction"
+    if certificate == "undecided" and status == "ok":
+        return "incomplete"
+    return status

@@ -92,6 +92,7 @@ def sweep(
     out: str | Path | None = None,
     progress: bool | Callable[[int, int, int], None] = False,
     command: list[str] | None = None,
+    certify: bool = False,
     **options,
 ) -> Sweep:
     """Solve `params` at every value of `param` (and of `param2`: a grid), then find branches
@@ -99,7 +100,8 @@ def sweep(
 
     The points are solved on `workers` local processes (or a Dask cluster at `scheduler`) and
     stored one by one under `out` (default: the cache folder), so the same request resumes where
-    it stopped and an unchanged finished sweep is not solved again.
+    it stopped and an unchanged finished sweep is not solved again. With `certify`, every point
+    is proved as `cb.certify` proves a solve (columns certified, certified_radius, certificate).
     """
     from ..continuation.runner import prepare
     from ..continuation.spec import SweepSpec
@@ -107,7 +109,7 @@ def sweep(
     settings = (settings or Settings()).replace(**options)
     spec = SweepSpec(
         params.as_dict(), param, tuple(values), param2,
-        None if values2 is None else tuple(values2), settings.as_dict(),
+        None if values2 is None else tuple(values2), settings.as_dict(), certify,
     )  # fmt: skip
     root = cache_root() / "sweeps" if out is None else output_root(out)
     folder = prepare(spec, root / spec.folder_name())

@@ -11,6 +11,7 @@ from pathlib import Path
 from ..errors import ParameterError, SolverError
 from ..fs import link_latest, new_run_folder, output_root
 from .options import (
+    EXIT_CERTIFICATE,
     EXIT_DISAGREE,
     EXIT_INCOMPLETE,
     EXIT_OK,
@@ -49,6 +50,7 @@ def solve(args: argparse.Namespace) -> int:
             shutil.move(str(folder), kept)
             print(f"cotm-bertini: the solver's files are in {kept}", file=sys.stderr)
         raise
+    cert = _certify(res) if getattr(args, "certify", False) else None
     folder = res.save(new_run_folder(root), plots=not args.no_plots, command=sys.argv[:])
     link_latest(root, folder)
     _warn(res.warnings)
@@ -60,7 +62,28 @@ def solve(args: argparse.Namespace) -> int:
             "--no-cache solves again",
             file=sys.stderr,
         )
+    if cert is not None:
+        print(f"certificate: {cert.statement} ({cert.seconds:.2f} s)")
+        if cert.status == "contradiction":
+            for text in cert.contradictions:
+                print(f"cotm-bertini: certificate: {text}", file=sys.stderr)
+            return EXIT_CERTIFICATE
+        if cert.status != "proved":
+            return EXIT_INCOMPLETE
     return EXIT_OK if res.status == "ok" else EXIT_INCOMPLETE
+
+
+def _certify(res):
+    """The certificate of a solve (kept on it, even when it contradicts the table)."""
+    from ..api.certificates import certify
+
+    return certify(res, strict=False)
+
+
+def certify(args: argparse.Namespace) -> int:
+    """`certify`: solve (or read the cache) and prove the result: `solve --certify`."""
+    args.certify = True
+    return solve(args)
 
 
 def _sweep_spec_values(args: argparse.Namespace, which: str) -> tuple[float, ...] | None:
@@ -113,6 +136,7 @@ def sweep(args: argparse.Namespace) -> int:
             base, args.param, values, settings_from(args), param2=args.param2,
             values2=values2, workers=workers, scheduler=args.scheduler,
             out=output_root(args.out), progress=progress, command=sys.argv[:],
+            certify=args.certify,
         )  # fmt: skip
     figures = [] if args.no_plots else sw.plot(show_all=args.all)
     rec, stats = sw.record, sw.record["stats"]

@@ -37,7 +37,26 @@ def _solve_parser(sub) -> None:
         "--no-cache", action="store_true", help="solve even if an identical request was answered"
     )
     s.add_argument("--quiet", action="store_true", help="print only where the files are")
+    s.add_argument(
+        "--certify",
+        action="store_true",
+        help="prove every solution and that no equilibrium is missing (docs/certify.md); "
+        "exit 4 if the proof contradicts the solver",
+    )
     s.set_defaults(run=commands.solve)
+    c = sub.add_parser(
+        "certify",
+        parents=[],
+        help="solve and prove: every solution certified, the physical set complete",
+    )
+    add_case(c)
+    add_params(c)
+    add_settings(c)
+    c.add_argument("--out", metavar="DIR", help="root of run folders (default runs/<label>)")
+    c.add_argument("--no-plots", action="store_true", help="skip the figures")
+    c.add_argument("--no-cache", action="store_true", help="solve even if answered before")
+    c.add_argument("--quiet", action="store_true", help="print only where the files are")
+    c.set_defaults(run=commands.certify)
 
 
 def _sweep_parser(sub) -> None:
@@ -65,6 +84,9 @@ def _sweep_parser(sub) -> None:
     w.add_argument("--all", action="store_true", help="plot the non-physical real roots too")
     w.add_argument("--no-plots", action="store_true", help="skip the figures")
     w.add_argument("--quiet", action="store_true", help="no progress report")
+    w.add_argument(
+        "--certify", action="store_true", help="prove every point (docs/certify.md); slower"
+    )
     w.set_defaults(run=commands.sweep, case=None)
 
 

@@ -64,7 +64,24 @@ def solve_run(spec: SweepSpec, indices: list[int]) -> Iterator[tuple[int, str, i
         solved = solve_point(spec.params_at(index), settings, warm=warm)
         warm, previous = solved.warm, index
         cols = point_columns(solved, spec.values_at(index), index)
+        if spec.certify:
+            _certify_point(spec.params_at(index), solved, cols)
         yield index, columns_csv(cols), int(np.nan_to_num(cols["lost_paths"][:1]).sum())
+
+
+def _certify_point(params: Params, solved: PointSolution, cols: dict) -> None:
+    """Prove the point (columns certified, certified_radius, certificate, certify_seconds); a
+    point whose proof is not complete is `incomplete`."""
+    from ..analysis.certify import certify_table
+
+    cert = certify_table(params, solved.columns)
+    n = len(cols["point"])
+    cols["certified"] = cert.certified
+    cols["certified_radius"] = cert.certified_radius
+    cols["certificate"] = np.full(n, cert.status, dtype=object)
+    cols["certify_seconds"] = np.full(n, cert.seconds)
+    if cert.status != "proved":
+        cols["status"] = np.full(n, "incomplete", dtype=object)
 
 
 def _run_task(args: tuple) -> list[tuple[int, str, int]]:

@@ -46,6 +46,7 @@ class SweepSpec:
     param2: str | None = None
     values2: tuple[float, ...] | None = None
     settings: dict = field(default_factory=lambda: Settings().as_dict())
+    certify: bool = False  # prove every point (docs/certify.md)
 
     def __post_init__(self) -> None:
         for name, option in ((self.param, "--param"), (self.param2, "--param2")):

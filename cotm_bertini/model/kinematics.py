@@ -85,3 +85,13 @@ def zero_length_poses(p: Any, spring: int) -> list[tuple[complex, complex, compl
         qq = qx * qx + qy * qy
         out.append((u[0], u[1], (qx * w[0] + qy * w[1]) / qq, (qx * w[1] - qy * w[0]) / qq))
     return out
+
+
+def spring_second_derivatives(
+    p: Any, spring: int, c1: Any, s1: Any, c2: Any, s2: Any
+) -> tuple[Pair, Pair, Pair]:
+    """d2 P / d gamma1^2 = -L3 u(gamma1), d2 P / d gamma1 d gamma2 = 0, d2 P / d gamma2^2 =
+    -R(gamma2) q (q: the spring's anchor on the top body, in T)."""
+    q = anchors(p)[spring][1]
+    zero = 0 * p.L3
+    return (-p.L3 * c1, -p.L3 * s1), (zero, zero), rotate(-c2, -s2, q)

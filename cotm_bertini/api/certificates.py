@@ -1,0 +1,24 @@
+"""`certify`: prove a solve's solutions and the completeness of its physical equilibria."""
+
+from __future__ import annotations
+
+from ..errors import CertificateError
+from .solutions import Solutions
+
+
+def certify(res: Solutions, strict: bool = True):
+    """Prove every reported solution (Krawczyk, ball arithmetic) and that no physical
+    equilibrium is missing (branch and bound over the torus); docs/certify.md says what exactly.
+
+    Returns the Certificate and attaches it to `res` (`res.certificate`; `res.table` gains the
+    columns `certified` and `certified_radius`; `res.save` writes them and a `certificate` block
+    in run.json). With `strict` (default), a difference between the proof and the table raises
+    CertificateError (the certificate is still attached: save the run to keep the evidence).
+    """
+    from ..analysis.certify import certify_table
+
+    cert = certify_table(res.params, res.table)
+    res.attach_certificate(cert)
+    if strict and cert.status == "contradiction":
+        raise CertificateError("; ".join(cert.contradictions), cert)
+    return cert

@@ -1,4 +1,5 @@
-"""What every column of solutions.csv, sweep.csv and events.csv means (written into each run)."""
+"""What every column of solutions.csv, sweep.csv, events.csv and the design CSV means (written
+into each run)."""
 
 from __future__ import annotations
 
@@ -76,6 +77,20 @@ EVENTS = {
     "variables, x, null_vector": "the point in solver variables and, for folds, the null vector",
 }
 
+DESIGN = {
+    "gamma1_deg, gamma2_deg": "the pose asked for (deg)",
+    "L01, L02": "the free lengths (m) holding the pose in equilibrium (may be negative: then not "
+    "physical)",
+    "d1, d2": "the spring lengths (m) at the pose",
+    "family": "relaxed (L0 = d: both springs at their free length, V = 0) or parallel (the pose "
+    "is on the curve where the springs' generalised forces are parallel; one free length chosen)",
+    "physical": "both free lengths >= 0",
+    "stable": "physical and the energy Hessian positive definite (eigenvalue > 1e-9 of the "
+    "largest)",
+    "hess_eig_min, hess_eig_max": "the Hessian's eigenvalues (J/rad^2) at the design",
+    "grad_residual": "the norm of grad V (J/rad) at the design, by the energy code: 0 up to rounding",
+}
+
 
 def markdown(title: str, columns: dict[str, str]) -> str:
     """A Markdown table of columns and their meanings."""
@@ -85,11 +100,12 @@ def markdown(title: str, columns: dict[str, str]) -> str:
 
 
 def reference(*tables: str, title: str = "Columns of the CSV files in this folder") -> str:
-    """The column reference of a run folder: 'solutions', 'sweep', 'events'."""
+    """The column reference of a run folder: 'solutions', 'sweep', 'events', 'design'."""
     known = {
         "solutions": ("solutions.csv", SOLUTIONS),
         "sweep": ("sweep.csv", SWEEP),
         "events": ("events.csv", EVENTS),
+        "design": ("the design CSV (`cotm-bertini design --out`)", DESIGN),
     }
     parts = [f"# {title}\n"]
     parts += [markdown(*known[t]) for t in tables]
@@ -98,4 +114,4 @@ def reference(*tables: str, title: str = "Columns of the CSV files in this folde
 
 def document() -> str:
     """docs/columns.md: every table's columns."""
-    return reference("solutions", "sweep", "events", title="Columns of the CSV files")
+    return reference("solutions", "sweep", "events", "design", title="Columns of the CSV files")

@@ -229,3 +229,24 @@ def params(args: argparse.Namespace) -> int:
     for name, value in p.as_dict().items():
         print(f"{name} = {value!r}  # {PARAM_UNITS[name]}, {PARAM_MEANING[name]}")
     return EXIT_OK
+
+
+def design(args: argparse.Namespace) -> int:
+    """`design`: the free lengths holding a pose, printed (and one CSV row with --out)."""
+    import pandas as pd
+
+    from ..analysis.design import design as design_pose
+    from ..fs import write_csv
+
+    params = params_from(args)
+    out = Path(args.out) if args.out else None
+    if out is not None and out.suffix.lower() != ".csv":
+        raise ParameterError(f"--out must name a .csv file, got {args.out!r}")
+    dsg = design_pose(params, args.gamma1, args.gamma2, L01=args.L01, L02=args.L02)
+    for name, value in dsg.as_dict().items():
+        print(f"{name} = {value}")
+    if out is not None:
+        output_root(out.parent if str(out.parent) else Path("."))
+        write_csv(out, pd.DataFrame([dsg.as_dict()]))
+        print(f"-> {out}")
+    return EXIT_OK

@@ -99,6 +99,21 @@ def _verify_parser(sub) -> None:
     v.set_defaults(run=commands.verify)
 
 
+def _design_parser(sub) -> None:
+    d = sub.add_parser(
+        "design", help="the free lengths that hold a chosen pose in equilibrium (inverse design)"
+    )
+    add_case(d, default="case3 (its L01, L02 are not used)")
+    add_params(d)
+    d.add_argument("--gamma1", type=float, required=True, metavar="DEG", help="rod angle")
+    d.add_argument("--gamma2", type=float, required=True, metavar="DEG", help="top body angle")
+    given = d.add_mutually_exclusive_group()
+    given.add_argument("--L01", type=float, metavar="M", help="choose L01 (parallel curve only)")
+    given.add_argument("--L02", type=float, metavar="M", help="choose L02 (parallel curve only)")
+    d.add_argument("--out", metavar="FILE.csv", help="also write the answer as a one-row CSV")
+    d.set_defaults(run=commands.design)
+
+
 def _parser() -> argparse.ArgumentParser:
     ap = Parser(prog="cotm-bertini", description=__doc__)
     ap.add_argument("--version", action="version", version=_version_text())
@@ -110,6 +125,7 @@ def _parser() -> argparse.ArgumentParser:
     pp.add_argument("--out", metavar="DIR", default="runs/paper", help="default runs/paper")
     pp.add_argument("--seed", type=int, default=1, help="solver seed (default 1)")
     pp.set_defaults(run=commands.paper)
+    _design_parser(sub)
     pr = sub.add_parser("params", help="print the parameters (Table 1 and a case preset)")
     add_case(pr, default="none: Table 1 as printed (L01 = L02 = 0)")
     add_params(pr)

@@ -1,0 +1,189 @@
+"""Inverse design: the free lengths that hold a chosen pose in equilibrium, and whether it is
+then physical and stable.
+
+With a_i = (P_i . dP_i/dgamma1, P_i . dP_i/dgamma2) (P_i the spring vector, d_i = |P_i|) the
+equilibrium equations are k_1 (1 - L01/d_1) a_1 + k_2 (1 - L02/d_2) a_2 = 0: linear in the free
+lengths. Where a_1 and a_2 are independent (almost every pose) the only solution is
+L0_i = d_i: both springs relaxed, V = 0, a global minimum. Only on the curve a_1 x a_2 = 0 of the
+torus (the springs' generalised forces parallel) can a pose be held by tensioned springs, and
+there the free lengths form a line: one of them is the designer's to choose.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+from types import SimpleNamespace
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..model.kinematics import dot, spring_jacobian, spring_vectors
+from ..params import Params
+from .energy_terms import gradient_hessian
+
+PARALLEL = 1e-9  # |a_1 x a_2| / (|a_1| |a_2|) below this: the pose is on the parallel curve
+ZERO_LENGTH = 1e-9  # a spring shorter than this (relative to L3) has no direction
+
+
+@dataclass(frozen=True)
+class Design:
+    """Free lengths (m) holding pose (gamma1, gamma2) in equilibrium, and what the pose is then."""
+
+    gamma1_deg: float
+    gamma2_deg: float
+    L01: float
+    L02: float
+    d1: float
+    d2: float
+    family: str  # "relaxed" (L0 = d, V = 0) or "parallel" (on the curve a_1 x a_2 = 0)
+    physical: bool
+    stable: bool
+    hess_eig_min: float
+    hess_eig_max: float
+    grad_residual: float  # the norm of grad V at the design, by the energy code
+
+    def as_dict(self) -> dict:
+        """The CSV row."""
+        return asdict(self)
+
+
+def generalised_forces(params: Params, g1, g2) -> tuple[np.ndarray, np.ndarray]:
+    """(a, d): a[i] = (P_i . dP_i/dgamma1, P_i . dP_i/dgamma2) and d[i] = |P_i|, for angles in
+    radians (arrays broadcast; a has shape (2, 2, ...))."""
+    g1, g2 = np.broadcast_arrays(np.asarray(g1, dtype=float), np.asarray(g2, dtype=float))
+    angles = (np.cos(g1), np.sin(g1), np.cos(g2), np.sin(g2))
+    vec = spring_vectors(params, *angles)
+    a = np.zeros((2, 2, *g1.shape))
+    d = np.zeros((2, *g1.shape))
+    for i in (0, 1):
+        pv = vec[f"spring{i + 1}"]
+        jac = spring_jacobian(params, i + 1, *angles)
+        d[i] = np.sqrt(dot(pv, pv))
+        a[i] = np.stack([np.asarray(dot(pv, jac[j]), dtype=float) for j in (0, 1)])
+    return a, d
+
+
+def parallel_sine(params: Params, g1, g2) -> np.ndarray:
+    """a_1 x a_2 / (|a_1| |a_2|): zero on the curve where tensioned springs can hold the pose."""
+    a, _ = generalised_forces(params, g1, g2)
+    cross = a[0, 0] * a[1, 1] - a[0, 1] * a[1, 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return cross / (np.hypot(*a[0]) * np.hypot(*a[1]))
+
+
+def design(
+    params: Params,
+    gamma1_deg: float,
+    gamma2_deg: float,
+    L01: float | None = None,
+    L02: float | None = None,
+) -> Design:
+    """The free lengths holding the pose of `params`' geometry (its own L01, L02 unused) in
+    equilibrium; on the parallel curve pass one of L01, L02. ParameterError where none exists."""
+    for name, value in (("gamma1", gamma1_deg), ("gamma2", gamma2_deg), ("L01", L01), ("L02", L02)):
+        if value is not None and not math.isfinite(value):
+            raise ParameterError(f"{name} must be a finite number, got {value!r}")
+    where = f"gamma1={gamma1_deg:g}, gamma2={gamma2_deg:g}"
+    g1, g2 = math.radians(gamma1_deg), math.radians(gamma2_deg)
+    a, d = generalised_forces(params, g1, g2)
+    for i in (0, 1):
+        if d[i] < ZERO_LENGTH * params.L3:
+            raise ParameterError(
+                f"{where}: spring {i + 1} has zero length there, so its pull has no direction"
+            )
+    if abs(float(parallel_sine(params, g1, g2))) > PARALLEL:
+        curve = parallel_curve(params, gamma1_deg) if (L01, L02) != (None, None) else []
+        l0 = _relaxed(d, L01, L02, where, curve)
+        family = "relaxed"
+    else:
+        l0 = _on_parallel_curve(params, a, d, L01, L02, where)
+        family = "parallel"
+    return _assess(params, gamma1_deg, gamma2_deg, l0, d, family)
+
+
+def _relaxed(d: np.ndarray, L01, L02, where: str, curve: list[float]) -> np.ndarray:
+    """L0 = d, refusing a given free length that differs (pointing to the parallel curve)."""
+    hint = ""
+    if curve:
+        hint = "; at this gamma1 the curve passes gamma2 = " + ", ".join(f"{g:.9f}" for g in curve)
+    for i, given in enumerate((L01, L02)):
+        if given is not None and abs(given - d[i]) > 1e-12 * max(1.0, d[i]):
+            raise ParameterError(
+                f"{where}: L0{i + 1}={given:g} cannot hold this pose: off the curve where the "
+                f"springs' generalised forces are parallel, only relaxed springs can "
+                f"(L01={d[0]:.12g}, L02={d[1]:.12g}){hint}"
+            )
+    return d.copy()
+
+
+def _on_parallel_curve(params: Params, a, d, L01, L02, where: str) -> np.ndarray:
+    """k1 (1 - l1) a1 + k2 (1 - l2) a2 = 0 with a2 = mu a1 (or a1 = 0): l_other from l_given."""
+    if (L01 is None) == (L02 is None):
+        raise ParameterError(
+            f"{where}: the pose lies on the curve where the springs' generalised forces are "
+            "parallel; its free lengths form a line, so pass exactly one of L01, L02"
+        )
+    k = (params.k1, params.k2)
+    n1, n2 = np.hypot(*a[0]), np.hypot(*a[1])
+    given = 0 if L01 is not None else 1
+    value = L01 if L01 is not None else L02
+    other = 1 - given
+    ell = np.ones(2)
+    ell[given] = value / d[given]
+    # Weight of spring i's (1 - l_i) along the common direction of a_1 and a_2.
+    u = a[0] / n1 if n1 >= n2 else a[1] / n2
+    w = [k[i] * float(np.dot(a[i], u)) for i in (0, 1)]
+    if abs(w[other]) <= PARALLEL * max(abs(w[0]), abs(w[1])):
+        if abs(w[given] * (1 - ell[given])) > PARALLEL * max(abs(w[0]), abs(w[1])):
+            raise ParameterError(
+                f"{where}: spring {other + 1} exerts no generalised force here, so spring "
+                f"{given + 1} must be relaxed (L0{given + 1}={d[given]:.12g})"
+            )
+        raise ParameterError(
+            f"{where}: spring {other + 1} exerts no generalised force here: any L0{other + 1} "
+            "holds the pose, so no unique design exists"
+        )
+    ell[other] = 1 + w[given] * (1 - ell[given]) / w[other]
+    return ell * d
+
+
+def _assess(params: Params, g1_deg: float, g2_deg: float, l0, d, family: str) -> Design:
+    """Hessian eigenvalues and gradient at the design (the free lengths may be negative: a
+    namespace, not a validated Params)."""
+    p = SimpleNamespace(**{**params.as_dict(), "L01": float(l0[0]), "L02": float(l0[1])})
+    g1, g2 = math.radians(g1_deg), math.radians(g2_deg)
+    angles = (math.cos(g1), math.sin(g1), math.cos(g2), math.sin(g2))
+    grad, hess = gradient_hessian(p, angles, math.sqrt)
+    eig = np.linalg.eigvalsh(np.array(hess, dtype=float))
+    physical = bool((np.asarray(l0) >= 0).all())
+    tol = 1e-9 * float(np.abs(eig).max())
+    return Design(
+        g1_deg, g2_deg, float(l0[0]), float(l0[1]), float(d[0]), float(d[1]), family,
+        physical, physical and bool(eig.min() > tol), float(eig.min()), float(eig.max()),
+        float(np.hypot(*grad)),
+    )  # fmt: skip
+
+
+def parallel_curve(params: Params, gamma1_deg: float, samples: int = 1440) -> list[float]:
+    """The gamma2 (degrees) where the pose (gamma1, gamma2) is on the parallel curve: sign
+    changes of a_1 x a_2 on a grid, each refined by bisection to rounding."""
+
+    def cross(g2):
+        a, _ = generalised_forces(params, math.radians(gamma1_deg), g2)
+        return a[0, 0] * a[1, 1] - a[0, 1] * a[1, 0]
+
+    grid = np.linspace(-np.pi, np.pi, samples + 1)
+    vals = cross(grid)
+    roots = []
+    for lo, hi, flo in zip(grid[:-1], grid[1:], vals[:-1], strict=True):
+        fhi = cross(hi)
+        if flo == 0:
+            roots.append(lo)
+        elif np.sign(flo) != np.sign(fhi):
+            for _ in range(60):
+                mid = 0.5 * (lo + hi)
+                fm = cross(mid)
+                lo, hi, flo = (mid, hi, fm) if np.sign(fm) == np.sign(flo) else (lo, mid, flo)
+            roots.append(0.5 * (lo + hi))
+    return [math.degrees(float(r)) for r in roots]

@@ -24,6 +24,8 @@ _EXPORTS = {
     "sweep": "cotm_bertini.api.sweeps",
     "resume_sweep": "cotm_bertini.api.sweeps",
     "certify": "cotm_bertini.api.certificates",
+    "barriers": "cotm_bertini.api.barriers",
+    "Barriers": "cotm_bertini.api.barriers",
     "design": "cotm_bertini.analysis.design",
     "Design": "cotm_bertini.analysis.design",
     "CertificateError": "cotm_bertini.errors",

@@ -1,5 +1,5 @@
-"""What every column of solutions.csv, sweep.csv, events.csv and the design CSV means (written
-into each run)."""
+"""What every column of solutions.csv, sweep.csv, events.csv, barriers.csv and the design CSV
+means (written into each run)."""
 
 from __future__ import annotations
 
@@ -88,7 +88,25 @@ DESIGN = {
     "stable": "physical and the energy Hessian positive definite (eigenvalue > 1e-9 of the "
     "largest)",
     "hess_eig_min, hess_eig_max": "the Hessian's eigenvalues (J/rad^2) at the design",
-    "grad_residual": "the norm of grad V (J/rad) at the design, by the energy code: 0 up to rounding",
+    "grad_residual": "the norm of grad V (J/rad) at the design, by the energy code: 0 up to "
+    "rounding",
+}
+
+BARRIERS = {
+    "saddle_id": "the solution_id (solutions.csv) of a physical saddle of V",
+    "min_a, min_b": "the solution_id of the minimum reached by gradient flow from the saddle "
+    "along +v and -v (v: the eigenvector of the negative Hessian eigenvalue); empty if the flow "
+    "did not end at a listed minimum",
+    "barrier_a, barrier_b": "V(saddle) - V(end of that descent) (J): the energy to climb from "
+    "that minimum over this saddle",
+    "saddle_gamma1_deg, saddle_gamma2_deg": "the saddle's angles (deg)",
+    "saddle_energy": "V at the saddle (J)",
+    "saddle_eigenvalues": "the Hessian's eigenvalues at the saddle (J/rad^2), ascending",
+    "converged": "both descents reached a point where Newton's step is below 1e-13 rad",
+    "crosses_zero_length": "a descent passed a spring shorter than 1e-3 L3 (V is not smooth "
+    "where a spring with L0 > 0 has zero length)",
+    "min_spring_length": "the shortest spring length along both descents (m)",
+    "lowest": "this saddle is the lowest joining its two distinct minima: their barrier",
 }
 
 
@@ -100,11 +118,13 @@ def markdown(title: str, columns: dict[str, str]) -> str:
 
 
 def reference(*tables: str, title: str = "Columns of the CSV files in this folder") -> str:
-    """The column reference of a run folder: 'solutions', 'sweep', 'events', 'design'."""
+    """The column reference of a run folder: 'solutions', 'sweep', 'events', 'barriers',
+    'design'."""
     known = {
         "solutions": ("solutions.csv", SOLUTIONS),
         "sweep": ("sweep.csv", SWEEP),
         "events": ("events.csv", EVENTS),
+        "barriers": ("barriers.csv", BARRIERS),
         "design": ("the design CSV (`cotm-bertini design --out`)", DESIGN),
     }
     parts = [f"# {title}\n"]
@@ -114,4 +134,6 @@ def reference(*tables: str, title: str = "Columns of the CSV files in this folde
 
 def document() -> str:
     """docs/columns.md: every table's columns."""
-    return reference("solutions", "sweep", "events", "design", title="Columns of the CSV files")
+    return reference(
+        "solutions", "sweep", "events", "barriers", "design", title="Columns of the CSV files"
+    )

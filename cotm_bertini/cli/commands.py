@@ -231,6 +231,26 @@ def params(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def barriers(args: argparse.Namespace) -> int:
+    """`barriers`: solve (or take the cached solve), then every saddle's descents and barriers."""
+    from ..api.barriers import barriers as find_barriers
+    from ..api.solutions import solve as solve_params
+
+    params, settings, label = params_from(args), settings_from(args), label_of(args)
+    root = output_root(args.out) if args.out else Path("runs") / f"barriers-{label}"
+    output_root(root)
+    found = find_barriers(solve_params(params, settings, label=label))
+    folder = found.save(new_run_folder(root), plots=not args.no_plots)
+    link_latest(root, folder)
+    _warn(found.warnings)
+    cols = ["saddle_id", "min_a", "min_b", "barrier_a", "barrier_b"]
+    pairs = found.pairs[cols]
+    print(f"{label}: {len(found.table)} saddles, {len(pairs)} pairs of minima joined")
+    print(pairs.to_string(index=False) if len(pairs) else "(no saddle joins two minima)")
+    print(_files_line(folder))
+    return EXIT_INCOMPLETE if found.warnings else EXIT_OK
+
+
 def design(args: argparse.Namespace) -> int:
     """`design`: the free lengths holding a pose, printed (and one CSV row with --out)."""
     import pandas as pd

@@ -99,6 +99,16 @@ def _verify_parser(sub) -> None:
     v.set_defaults(run=commands.verify)
 
 
+def _barriers_parser(sub) -> None:
+    b = sub.add_parser("barriers", help="energy barriers between the stable equilibria")
+    add_case(b)
+    add_params(b)
+    add_settings(b)
+    b.add_argument("--out", metavar="DIR", help="default runs/barriers-<label>")
+    b.add_argument("--no-plots", action="store_true", help="skip the picture of the paths")
+    b.set_defaults(run=commands.barriers)
+
+
 def _design_parser(sub) -> None:
     d = sub.add_parser(
         "design", help="the free lengths that hold a chosen pose in equilibrium (inverse design)"
@@ -125,6 +135,7 @@ def _parser() -> argparse.ArgumentParser:
     pp.add_argument("--out", metavar="DIR", default="runs/paper", help="default runs/paper")
     pp.add_argument("--seed", type=int, default=1, help="solver seed (default 1)")
     pp.set_defaults(run=commands.paper)
+    _barriers_parser(sub)
     _design_parser(sub)
     pr = sub.add_parser("params", help="print the parameters (Table 1 and a case preset)")
     add_case(pr, default="none: Table 1 as printed (L01 = L02 = 0)")

@@ -121,3 +121,21 @@ def energy_map_figure(params: Params, solutions: pd.DataFrame, n: int = 300) -> 
 def plot_energy_map(params: Params, solutions: pd.DataFrame, path: str | Path) -> list[Path]:
     """Energy contours with the equilibria (see energy_map_figure); write PNG and SVG."""
     return save(energy_map_figure(params, solutions), path)
+
+
+def barrier_figure(params: Params, solutions: pd.DataFrame, paths: dict, n: int = 300) -> Figure:
+    """The energy map with each saddle's two descent paths (gid `descent-<saddle_id>`), drawn
+    modulo 360 deg with a break where a path wraps."""
+    fig = energy_map_figure(params, solutions, n)
+    ax = fig.axes[0]
+    for saddle, halves in paths.items():
+        for path in halves:
+            wrapped = np.mod(path, 360.0)
+            jumps = np.abs(np.diff(wrapped, axis=0)).max(axis=1) > 180.0
+            xy = np.insert(wrapped, np.flatnonzero(jumps) + 1, np.nan, axis=0)
+            ax.plot(*xy.T, color="white", lw=1.4, gid=f"descent-{saddle}")
+    ax.set_title(
+        "Gradient descent from each saddle (white) on V(gamma1, gamma2)\n" + describe(params),
+        fontsize=10,
+    )
+    return fig

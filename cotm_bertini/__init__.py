@@ -27,6 +27,7 @@ _EXPORTS = {
     "barriers": "cotm_bertini.api.barriers",
     "Barriers": "cotm_bertini.api.barriers",
     "design": "cotm_bertini.analysis.design",
+    "fold_curves": "cotm_bertini.analysis.fold_curves",
     "Design": "cotm_bertini.analysis.design",
     "CertificateError": "cotm_bertini.errors",
     "CotmError": "cotm_bertini.errors",

@@ -77,6 +77,15 @@ EVENTS = {
     "variables, x, null_vector": "the point in solver variables and, for folds, the null vector",
 }
 
+FOLDS = {
+    "L01, L02": "the free lengths (m) of the fold point (either may be negative: not physical)",
+    "gamma1_deg, gamma2_deg": "the equilibrium's angles (deg) in [0, 360)",
+    "d1, d2": "the spring lengths (m)",
+    "physical": "both free lengths >= 0",
+    "kind": "fold (cusps are not yet detected)",
+    "hess_eig_min": "the Hessian eigenvalue nearest zero (J/rad^2): 0 at a fold, up to rounding",
+}
+
 DESIGN = {
     "gamma1_deg, gamma2_deg": "the pose asked for (deg)",
     "L01, L02": "the free lengths (m) holding the pose in equilibrium (may be negative: then not "
@@ -119,12 +128,13 @@ def markdown(title: str, columns: dict[str, str]) -> str:
 
 def reference(*tables: str, title: str = "Columns of the CSV files in this folder") -> str:
     """The column reference of a run folder: 'solutions', 'sweep', 'events', 'barriers',
-    'design'."""
+    'folds', 'design'."""
     known = {
         "solutions": ("solutions.csv", SOLUTIONS),
         "sweep": ("sweep.csv", SWEEP),
         "events": ("events.csv", EVENTS),
         "barriers": ("barriers.csv", BARRIERS),
+        "folds": ("the fold table (`cb.fold_curves`)", FOLDS),
         "design": ("the design CSV (`cotm-bertini design --out`)", DESIGN),
     }
     parts = [f"# {title}\n"]
@@ -135,5 +145,11 @@ def reference(*tables: str, title: str = "Columns of the CSV files in this folde
 def document() -> str:
     """docs/columns.md: every table's columns."""
     return reference(
-        "solutions", "sweep", "events", "barriers", "design", title="Columns of the CSV files"
+        "solutions",
+        "sweep",
+        "events",
+        "barriers",
+        "folds",
+        "design",
+        title="Columns of the CSV files",
     )

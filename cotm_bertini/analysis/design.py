@@ -165,25 +165,36 @@ def _assess(params: Params, g1_deg: float, g2_deg: float, l0, d, family: str) ->
     )  # fmt: skip
 
 
-def parallel_curve(params: Params, gamma1_deg: float, samples: int = 1440) -> list[float]:
-    """The gamma2 (degrees) where the pose (gamma1, gamma2) is on the parallel curve: sign
-    changes of a_1 x a_2 on a grid, each refined by bisection to rounding."""
+def _cross(params: Params, g1, g2) -> np.ndarray:
+    a, _ = generalised_forces(params, g1, g2)
+    return a[0, 0] * a[1, 1] - a[0, 1] * a[1, 0]
 
-    def cross(g2):
-        a, _ = generalised_forces(params, math.radians(gamma1_deg), g2)
-        return a[0, 0] * a[1, 1] - a[0, 1] * a[1, 0]
 
+def parallel_roots(
+    params: Params, fixed: np.ndarray, axis: int = 0, samples: int = 1440
+) -> tuple[np.ndarray, np.ndarray]:
+    """Points of the parallel curve: for each angle in `fixed` (rad; gamma1 if axis is 0, else
+    gamma2) every root of a_1 x a_2 in the other angle, from sign changes on `samples` steps,
+    bisected to rounding. Returns (fixed angle, root) arrays, one entry a root."""
+    fixed = np.asarray(fixed, dtype=float)
     grid = np.linspace(-np.pi, np.pi, samples + 1)
-    vals = cross(grid)
-    roots = []
-    for lo, hi, flo in zip(grid[:-1], grid[1:], vals[:-1], strict=True):
-        fhi = cross(hi)
-        if flo == 0:
-            roots.append(lo)
-        elif np.sign(flo) != np.sign(fhi):
-            for _ in range(60):
-                mid = 0.5 * (lo + hi)
-                fm = cross(mid)
-                lo, hi, flo = (mid, hi, fm) if np.sign(fm) == np.sign(flo) else (lo, mid, flo)
-            roots.append(0.5 * (lo + hi))
-    return [math.degrees(float(r)) for r in roots]
+    F, G = np.meshgrid(fixed, grid, indexing="ij")
+
+    def cross(f, g):
+        return _cross(params, f, g) if axis == 0 else _cross(params, g, f)
+
+    vals = cross(F, G)
+    i, j = np.nonzero(np.sign(vals[:, :-1]) != np.sign(vals[:, 1:]))
+    lo, hi, flo, fix = grid[j], grid[j + 1], vals[i, j], fixed[i]
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        fm = cross(fix, mid)
+        same = np.sign(fm) == np.sign(flo)
+        lo, flo, hi = np.where(same, mid, lo), np.where(same, fm, flo), np.where(same, hi, mid)
+    return fix, 0.5 * (lo + hi)
+
+
+def parallel_curve(params: Params, gamma1_deg: float, samples: int = 1440) -> list[float]:
+    """The gamma2 (degrees) where the pose (gamma1, gamma2) is on the parallel curve."""
+    _, roots = parallel_roots(params, np.array([math.radians(gamma1_deg)]), 0, samples)
+    return [math.degrees(float(r)) for r in np.sort(roots)]

@@ -5,7 +5,7 @@ BIN     := $(VENV)/bin
 STAMP   := $(VENV)/.installed
 CLI     := $(BIN)/cotm-bertini
 
-.PHONY: install phcpack case1 case2 case3 test stress sweep bench verify paper lint format clean-runs
+.PHONY: install phcpack case1 case2 case3 test stress sweep map bench verify paper lint format clean-runs
 
 $(STAMP): pyproject.toml
 	@$(PY) -c 'import venv, ensurepip' 2>/dev/null || { \
@@ -41,9 +41,13 @@ paper: $(STAMP)
 sweep: $(STAMP)
 	$(CLI) sweep --param L01 --from 0 --to 12 --points 241 --out runs
 
+# The design map of the paper geometry: stable-count regions (101 x 101 solves) and fold curves.
+map: $(STAMP)
+	$(CLI) map --param L01 --from 0 --to 14 --param2 L02 --from2 0 --to2 14 --points 101
+
 # The full stress set (200 random geometries, 20 seeds); `make test` runs a fast subset.
 stress: $(STAMP) phcpack
-	COTM_STRESS=full $(BIN)/pytest -q tests/stress
+	COTM_STRESS=full $(BIN)/pytest -q tests/stress tests/test_fold_curves.py
 
 bench: $(STAMP) phcpack
 	$(BIN)/python bench/run_all.py

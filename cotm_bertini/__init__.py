@@ -28,6 +28,8 @@ _EXPORTS = {
     "Barriers": "cotm_bertini.api.barriers",
     "design": "cotm_bertini.analysis.design",
     "fold_curves": "cotm_bertini.analysis.fold_curves",
+    "design_map": "cotm_bertini.api.maps",
+    "DesignMap": "cotm_bertini.api.maps",
     "Design": "cotm_bertini.analysis.design",
     "CertificateError": "cotm_bertini.errors",
     "CotmError": "cotm_bertini.errors",

@@ -82,8 +82,18 @@ FOLDS = {
     "gamma1_deg, gamma2_deg": "the equilibrium's angles (deg) in [0, 360)",
     "d1, d2": "the spring lengths (m)",
     "physical": "both free lengths >= 0",
+    "family": "relaxed (both springs at their free length: L0 = d) or tensioned (the pose on the "
+    "parallel curve with free lengths on its line)",
+    "curve_id": "the connected piece of the fold set the point belongs to (points of one family "
+    "within 1 deg in pose and 0.05 L3 in free length are joined)",
     "kind": "fold (cusps are not yet detected)",
     "hess_eig_min": "the Hessian eigenvalue nearest zero (J/rad^2): 0 at a fold, up to rounding",
+}
+
+REGIONS = {
+    "L01, L02": "a grid point (m)",
+    "physical": "the number of physical equilibria there (a direct solve)",
+    "stable": "the number of stable equilibria there",
 }
 
 DESIGN = {
@@ -128,13 +138,14 @@ def markdown(title: str, columns: dict[str, str]) -> str:
 
 def reference(*tables: str, title: str = "Columns of the CSV files in this folder") -> str:
     """The column reference of a run folder: 'solutions', 'sweep', 'events', 'barriers',
-    'folds', 'design'."""
+    'folds', 'regions', 'design'."""
     known = {
         "solutions": ("solutions.csv", SOLUTIONS),
         "sweep": ("sweep.csv", SWEEP),
         "events": ("events.csv", EVENTS),
         "barriers": ("barriers.csv", BARRIERS),
-        "folds": ("the fold table (`cb.fold_curves`)", FOLDS),
+        "folds": ("folds.csv (`cb.fold_curves`)", FOLDS),
+        "regions": ("regions.csv", REGIONS),
         "design": ("the design CSV (`cotm-bertini design --out`)", DESIGN),
     }
     parts = [f"# {title}\n"]

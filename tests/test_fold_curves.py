@@ -5,8 +5,12 @@ physical equilibria, and the paper's 1-D fold (L01 = 11.0128 m at L02 = 0) lies 
 from __future__ import annotations
 
 import math
+import os
+import subprocess
+import sys
 
 import numpy as np
+import pandas as pd
 import pytest
 
 import cotm_bertini as cb
@@ -33,20 +37,21 @@ def test_fold_points_are_degenerate_equilibria(folds):
         assert abs(r.hess_eig_min) < 1e-8 * np.linalg.norm(hess)
 
 
-def _crossings(folds, l02: float) -> np.ndarray:
-    """L01 where the sampled fold curve crosses L02 = l02: linear interpolation between fold
-    points within 0.1 m of the line on either side, whose poses differ by at most 1 deg but are
-    not the same pose (neighbouring samples of one curve, not the two roots of one pose) and
-    whose L01 differ by under 0.1 m."""
-    pts = folds[["L01", "L02", "gamma1_deg", "gamma2_deg"]].to_numpy(float)
-    pts = pts[np.abs(pts[:, 1] - l02) < 0.1]
-    below, above = pts[pts[:, 1] < l02], pts[pts[:, 1] >= l02]
+def _crossings(folds, value: float, axis: str = "L02") -> np.ndarray:
+    """Where the sampled fold curves cross the line `axis` = value: the other free length,
+    interpolated between fold points within 0.1 m of the line on either side that are
+    neighbouring samples of one curve (poses within 1 deg but not the same pose, so not the two
+    roots of one pose; free lengths within 0.1 m)."""
+    other = "L01" if axis == "L02" else "L02"
+    pts = folds[[other, axis, "gamma1_deg", "gamma2_deg"]].to_numpy(float)
+    pts = pts[np.abs(pts[:, 1] - value) < 0.1]
+    below, above = pts[pts[:, 1] < value], pts[pts[:, 1] >= value]
     gap = below[:, None, 2:] - above[None, :, 2:]
     gap = np.abs((gap + 180) % 360 - 180).max(axis=2)
     close = np.abs(below[:, None, 0] - above[None, :, 0]) < 0.1
     i, j = np.nonzero((gap < 1.0) & (gap > 1e-9) & close)
     a, b = below[i], above[j]
-    return a[:, 0] + (l02 - a[:, 1]) / (b[:, 1] - a[:, 1]) * (b[:, 0] - a[:, 0])
+    return a[:, 0] + (value - a[:, 1]) / (b[:, 1] - a[:, 1]) * (b[:, 0] - a[:, 0])
 
 
 def test_the_paper_fold_lies_on_the_curve(folds):
@@ -65,3 +70,61 @@ def test_direct_solves_either_side_differ_by_two(folds, index):
         res = cb.solve(P.replace(L01=r.L01 + step, L02=r.L02), cache=False)
         counts.append(len(res.physical))
     assert abs(counts[0] - counts[1]) == 2
+
+
+def test_stable_count_changes_only_across_fold_curves(folds):
+    """Completeness on the paper geometry: wherever direct solves on neighbouring grid points
+    disagree on the number of stable equilibria, a fold curve crosses the segment between them
+    (41 x 41 over (0, 14] with COTM_STRESS=full, 11 x 11 otherwise)."""
+    n = 41 if os.environ.get("COTM_STRESS") == "full" else 11
+    lo = 14.0 / n
+    regions = cb.design_map(P, (lo, 14.0), (lo, 14.0), n, workers=2).regions
+    grid = regions.pivot(index="L02", columns="L01", values="stable")
+    xs, ys = grid.columns.to_numpy(float), grid.index.to_numpy(float)
+    changes = 0
+    for axis, fixed_values, moving in (("L02", ys, xs), ("L01", xs, ys)):
+        for v in fixed_values:
+            cut = _crossings(folds, v, axis)
+            line = grid.loc[v] if axis == "L02" else grid[v]
+            for a, b in zip(moving[:-1], moving[1:], strict=True):
+                if line.loc[a] != line.loc[b]:
+                    changes += 1
+                    assert ((cut > a - 1e-3) & (cut < b + 1e-3)).any(), (axis, v, a, b)
+    assert changes > 0
+
+
+def _map_cli(*args: str) -> subprocess.CompletedProcess:
+    cmd = [sys.executable, "-m", "cotm_bertini.cli", "map", "--quiet", *args]
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+
+
+@pytest.mark.parametrize(
+    ("args", "named"),
+    [
+        (("--param", "p5y"), "--param p5y"),
+        (("--from", "5", "--to", "5"), "L01: the range 5 to 5 is empty"),
+        (("--from2", "-1"), "L02 from -1"),
+        (("--points", "1"), "--points 1"),
+    ],
+)
+def test_map_refuses_bad_input_in_one_line(tmp_path, args, named):
+    run = _map_cli(*args, "--out", str(tmp_path / "m"))
+    assert run.returncode == 2
+    assert run.stderr.count("\n") == 1 and named in run.stderr
+    assert not (tmp_path / "m").exists() or not any((tmp_path / "m").iterdir())
+
+
+def test_map_writes_folds_regions_and_the_picture(tmp_path):
+    window = ("--from", "10", "--to", "12", "--from2", "10", "--to2", "12", "--points", "5")
+    run = _map_cli(*window, "--workers", "1", "--out", str(tmp_path))
+    assert run.returncode == 0, run.stderr
+    folder = tmp_path / "latest"
+    folds = pd.read_csv(folder / "folds.csv")
+    for col in ("L01", "L02", "gamma1_deg", "gamma2_deg", "d1", "d2", "curve_id", "kind"):
+        assert col in folds.columns
+    assert folds.L01.between(10, 12).all() and folds.L02.between(10, 12).all()
+    regions = pd.read_csv(folder / "regions.csv")
+    assert len(regions) == 25 and (regions.stable <= regions.physical).all()
+    case3 = regions[(regions.L01 == 11.5) & (regions.L02 == 11.5)]
+    assert int(case3.stable.iloc[0]) == len(cb.solve(P).stable)
+    assert (folder / "map.png").is_file() and (folder / "run.json").is_file()

@@ -22,8 +22,11 @@ from ..params import Params
 from .design import generalised_forces, parallel_roots
 
 FOLD_COLUMNS = [
-    "L01", "L02", "gamma1_deg", "gamma2_deg", "d1", "d2", "physical", "kind", "hess_eig_min",
+    "L01", "L02", "gamma1_deg", "gamma2_deg", "d1", "d2", "physical", "family", "curve_id",
+    "kind", "hess_eig_min",
 ]  # fmt: skip
+LINK_DEG = 1.0  # fold points whose poses differ by less than this ...
+LINK_LENGTH = 0.05  # ... and whose free lengths differ by less than this times L3 are linked
 
 
 def parallel_samples(params: Params, points: int = 1500) -> np.ndarray:
@@ -82,7 +85,40 @@ def fold_curves(params: Params, points: int = 1500) -> pd.DataFrame:
                 rows.append(
                     (l0[0], l0[1], g1[n], g2[n], d[0, n], d[1, n], eig[np.argmin(abs(eig))])
                 )
-    return _table(rows)
+    table = _table(rows)
+    return table.assign(curve_id=link_curves(table, params.L3))
+
+
+def link_curves(folds: pd.DataFrame, length_scale: float) -> np.ndarray:
+    """A curve id for each fold point: the connected pieces of the fold set, joining points of
+    one family whose poses differ by under LINK_DEG and free lengths by under LINK_LENGTH L3."""
+    pose = folds[["gamma1_deg", "gamma2_deg"]].to_numpy(float)
+    l0 = folds[["L01", "L02"]].to_numpy(float)
+    fam = folds.family.to_numpy()
+    cells: dict[tuple, list[int]] = {}
+    keys = np.floor(pose / LINK_DEG).astype(int)
+    for n, key in enumerate(map(tuple, keys)):
+        cells.setdefault(key, []).append(n)
+    parent = np.arange(len(folds))
+
+    def root(n: int) -> int:
+        while parent[n] != n:
+            parent[n] = parent[parent[n]]
+            n = parent[n]
+        return n
+
+    wrap = int(round(360 / LINK_DEG))
+    for n, (a, b) in enumerate(keys):
+        for da in (-1, 0, 1):
+            for db in (-1, 0, 1):
+                for m in cells.get(((a + da) % wrap, (b + db) % wrap), ()):
+                    gap = np.abs((pose[n] - pose[m] + 180) % 360 - 180).max()
+                    near = np.abs(l0[n] - l0[m]).max() < LINK_LENGTH * length_scale
+                    if m > n and fam[m] == fam[n] and gap < LINK_DEG and near:
+                        parent[root(m)] = root(n)
+    roots = np.array([root(n) for n in range(len(folds))])
+    _, ids = np.unique(roots, return_inverse=True)
+    return ids
 
 
 def _table(rows: list[tuple]) -> pd.DataFrame:
@@ -94,7 +130,11 @@ def _table(rows: list[tuple]) -> pd.DataFrame:
             "gamma2_deg": np.mod(np.degrees(arr[:, 3]), 360.0),
             "d1": arr[:, 4], "d2": arr[:, 5],
             "physical": (arr[:, 0] >= 0) & (arr[:, 1] >= 0),
-            "kind": "fold", "hess_eig_min": arr[:, 6],
+            "family": np.where(
+                np.abs(arr[:, :2] - arr[:, 4:6]).max(axis=1) <= 1e-9 * arr[:, 4:6].max(axis=1),
+                "relaxed", "tensioned",
+            ),
+            "curve_id": -1, "kind": "fold", "hess_eig_min": arr[:, 6],
         },
         columns=FOLD_COLUMNS,
     )  # fmt: skip

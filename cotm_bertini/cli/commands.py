@@ -251,6 +251,35 @@ def barriers(args: argparse.Namespace) -> int:
     return EXIT_INCOMPLETE if found.warnings else EXIT_OK
 
 
+def design_map(args: argparse.Namespace) -> int:
+    """`map`: fold curves and stable-count regions over the (L01, L02) plane."""
+    from ..api.maps import FREE_LENGTHS
+    from ..api.maps import design_map as make_map
+    from ..continuation.runner import default_workers
+
+    if {args.param, args.param2} != set(FREE_LENGTHS):
+        raise ParameterError(
+            f"--param {args.param} --param2 {args.param2}: the map is over the free lengths, "
+            "so the two axes must be L01 and L02"
+        )
+    workers = default_workers() if args.workers is None else args.workers
+    if workers < 1:
+        raise ParameterError(f"--workers {workers}: must be >= 1")
+    ranges = {args.param: (args.start, args.stop), args.param2: (args.start2, args.stop2)}
+    root = output_root(args.out)
+    found = make_map(
+        params_from(args), ranges["L01"], ranges["L02"], args.points, settings_from(args),
+        workers=workers, progress=not args.quiet,
+    )  # fmt: skip
+    folder = found.save(new_run_folder(root), plots=not args.no_plots)
+    link_latest(root, folder)
+    counts = found.regions.stable.value_counts().sort_index()
+    spread = ", ".join(f"{n} stable: {c} points" for n, c in counts.items())
+    print(f"map: {len(found.folds)} fold points on {found.record['fold_curves']} pieces; {spread}")
+    print(_files_line(folder))
+    return EXIT_OK if found.record["sweep_status"] == "ok" else EXIT_INCOMPLETE
+
+
 def design(args: argparse.Namespace) -> int:
     """`design`: the free lengths holding a pose, printed (and one CSV row with --out)."""
     import pandas as pd

@@ -109,6 +109,24 @@ def _barriers_parser(sub) -> None:
     b.set_defaults(run=commands.barriers)
 
 
+def _map_parser(sub) -> None:
+    m = sub.add_parser("map", help="stable-count regions and fold curves over (L01, L02)")
+    add_params(m)
+    add_settings(m)
+    m.add_argument("--param", default="L01", help="first axis: L01 or L02 (default L01)")
+    m.add_argument("--from", dest="start", type=float, default=0.0, help="default 0")
+    m.add_argument("--to", dest="stop", type=float, default=14.0, help="default 14")
+    m.add_argument("--param2", default="L02", help="second axis (default L02)")
+    m.add_argument("--from2", dest="start2", type=float, default=0.0, help="default 0")
+    m.add_argument("--to2", dest="stop2", type=float, default=14.0, help="default 14")
+    m.add_argument("--points", type=int, default=101, help="grid points a side (default 101)")
+    m.add_argument("--workers", type=int, help="local processes (default: one per core)")
+    m.add_argument("--out", metavar="DIR", default="runs/map", help="default runs/map")
+    m.add_argument("--no-plots", action="store_true", help="skip map.png/svg")
+    m.add_argument("--quiet", action="store_true", help="no progress report")
+    m.set_defaults(run=commands.design_map, case=None)
+
+
 def _design_parser(sub) -> None:
     d = sub.add_parser(
         "design", help="the free lengths that hold a chosen pose in equilibrium (inverse design)"
@@ -136,6 +154,7 @@ def _parser() -> argparse.ArgumentParser:
     pp.add_argument("--seed", type=int, default=1, help="solver seed (default 1)")
     pp.set_defaults(run=commands.paper)
     _barriers_parser(sub)
+    _map_parser(sub)
     _design_parser(sub)
     pr = sub.add_parser("params", help="print the parameters (Table 1 and a case preset)")
     add_case(pr, default="none: Table 1 as printed (L01 = L02 = 0)")

@@ -1,0 +1,108 @@
+"""The design map of the (L01, L02) plane (cb.design_map): fold curves, stable-count regions."""
+
+from __future__ import annotations
+
+import math
+import shutil
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..columns import reference
+from ..errors import ParameterError
+from ..fs import atomic_write_text, partial_name, write_csv, write_json
+from ..params import Params
+from ..settings import Settings
+
+FREE_LENGTHS = ("L01", "L02")
+
+
+@dataclass(frozen=True)
+class DesignMap:
+    """Fold points inside the window (`folds`), the grid of counts (`regions`), timings."""
+
+    params: Params
+    folds: pd.DataFrame
+    regions: pd.DataFrame
+    record: dict
+
+    def plot(self, path: str | Path) -> list[Path]:
+        """map.png/svg: stable counts coloured, fold curves on top, the paper's cases marked."""
+        from ..plot.design_map import plot_map
+
+        return plot_map(self.params, self.regions, self.folds, path)
+
+    def save(self, folder: str | Path, plots: bool = True) -> Path:
+        """folds.csv, regions.csv, columns.md, run.json [, map.png/svg] in a new folder, built
+        under a hidden name and renamed when complete."""
+        dest = Path(folder)
+        if dest.exists():
+            raise FileExistsError(f"{dest} exists: a map is written to a new folder")
+        work = partial_name(dest)
+        shutil.rmtree(work, ignore_errors=True)
+        work.mkdir(parents=True)
+        write_csv(work / "folds.csv", self.folds)
+        write_csv(work / "regions.csv", self.regions)
+        atomic_write_text(work / "columns.md", reference("folds", "regions"))
+        if plots:
+            self.plot(work / "map")
+        write_json(work / "run.json", self.record)
+        work.rename(dest)
+        return dest
+
+
+def _window(name: str, lo: float, hi: float, points: int) -> None:
+    for what, v in ((f"{name} from", lo), (f"{name} to", hi)):
+        if not math.isfinite(v) or v < 0:
+            raise ParameterError(f"{what} {v!r}: a free length must be finite and >= 0")
+    if not hi > lo:
+        raise ParameterError(f"{name}: the range {lo:g} to {hi:g} is empty (need from < to)")
+    if points < 2:
+        raise ParameterError(f"--points {points}: a map needs at least 2 points a side")
+
+
+def design_map(
+    params: Params,
+    l01: tuple[float, float] = (0.0, 14.0),
+    l02: tuple[float, float] = (0.0, 14.0),
+    points: int = 101,
+    settings: Settings | None = None,
+    workers: int = 1,
+    progress: bool = False,
+) -> DesignMap:
+    """Fold curves in the window, and the number of physical and stable equilibria on a
+    points x points grid of it (by a 2-D sweep: parameter homotopies)."""
+    from ..analysis.fold_curves import fold_curves
+    from .sweeps import sweep
+
+    _window("L01", *l01, points)
+    _window("L02", *l02, points)
+    t0 = time.perf_counter()
+    folds = fold_curves(params)
+    t_folds = time.perf_counter() - t0
+    inside = folds.physical & folds.L01.between(*l01) & folds.L02.between(*l02)
+    folds = folds[inside].reset_index(drop=True)
+    xs, ys = np.linspace(*l01, points), np.linspace(*l02, points)
+    sw = sweep(params, "L01", xs, settings, param2="L02", values2=ys, workers=workers,
+               progress=progress)  # fmt: skip
+    regions = _counts(sw.table, xs, ys)
+    record = {
+        "params": params.as_dict(), "window": {"L01": list(l01), "L02": list(l02)},
+        "points": points, "fold_points": len(folds), "fold_curves": int(folds.curve_id.nunique()),
+        "timings": {"folds": t_folds, "regions": time.perf_counter() - t0 - t_folds},
+        "sweep_folder": str(sw.folder), "sweep_status": sw.status, "command": sys.argv[:],
+    }  # fmt: skip
+    return DesignMap(params, folds, regions, record)
+
+
+def _counts(table: pd.DataFrame, xs: np.ndarray, ys: np.ndarray) -> pd.DataFrame:
+    """Physical and stable equilibria at each grid point (0 where a point has no row)."""
+    t = table.assign(physical=table.physical.astype(bool), stable=table.stable.astype(bool))
+    counts = t.groupby(["L01", "L02"], sort=True)[["physical", "stable"]].sum()
+    full = pd.MultiIndex.from_product([xs, ys], names=["L01", "L02"])
+    counts = counts.reindex(full, fill_value=0)
+    return counts.reset_index().astype({"physical": int, "stable": int})

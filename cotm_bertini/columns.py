@@ -86,7 +86,8 @@ FOLDS = {
     "parallel curve with free lengths on its line)",
     "curve_id": "the connected piece of the fold set the point belongs to (points of one family "
     "within 1 deg in pose and 0.05 L3 in free length are joined)",
-    "kind": "fold (cusps are not yet detected)",
+    "kind": "fold, or cusp: where a fold curve stops and turns back (a degenerate fold; its "
+    "curve_id is -1)",
     "hess_eig_min": "the Hessian eigenvalue nearest zero (J/rad^2): 0 at a fold, up to rounding",
 }
 

@@ -63,7 +63,8 @@ def test_the_paper_fold_lies_on_the_curve(folds):
 @pytest.mark.parametrize("index", [0, 1, 2])
 def test_direct_solves_either_side_differ_by_two(folds, index):
     rng = np.random.default_rng(100 + index)
-    phys = folds[folds.physical & folds.L01.between(1, 13) & folds.L02.between(1, 13)]
+    plain = folds.physical & (folds.kind == "fold")
+    phys = folds[plain & folds.L01.between(1, 13) & folds.L02.between(1, 13)]
     r = phys.iloc[int(rng.integers(len(phys)))]
     counts = []
     for step in (-1e-4, 1e-4):
@@ -128,3 +129,25 @@ def test_map_writes_folds_regions_and_the_picture(tmp_path):
     case3 = regions[(regions.L01 == 11.5) & (regions.L02 == 11.5)]
     assert int(case3.stable.iloc[0]) == len(cb.solve(P).stable)
     assert (folder / "map.png").is_file() and (folder / "run.json").is_file()
+
+
+def test_cusps_are_degenerate_folds(folds):
+    """At a cusp of a tensioned fold curve the energy's third derivative along the Hessian's null
+    vector vanishes too (by finite differences of the energy code's Hessian); at ordinary
+    tensioned fold points it does not."""
+    cusp = folds[(folds.kind == "cusp") & folds.physical]
+    assert set(cusp.family) == {"relaxed", "tensioned"} and len(cusp) >= 6
+
+    def cubic(r, eps=1e-5):
+        q = P.replace(L01=r.L01, L02=r.L02)
+        g = np.radians([r.gamma1_deg, r.gamma2_deg])
+        hess = energy_hessian(q, *g)[0]
+        ev, vec = np.linalg.eigh(hess)
+        w = vec[:, np.argmin(abs(ev))]
+        along = [w @ energy_hessian(q, *(g + e * w))[0] @ w for e in (eps, -eps)]
+        return abs(along[0] - along[1]) / (2 * eps) / np.linalg.norm(hess)
+
+    for _, r in cusp[cusp.family == "tensioned"].iterrows():
+        assert cubic(r) < 1e-6
+    plain = folds[(folds.kind == "fold") & (folds.family == "tensioned") & folds.physical]
+    assert np.median([cubic(r) for _, r in plain.sample(20, random_state=0).iterrows()]) > 1e-3

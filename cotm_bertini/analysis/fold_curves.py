@@ -56,37 +56,53 @@ def _det(x: np.ndarray) -> np.ndarray:
     return x[0, 0] * x[1, 1] - x[0, 1] * x[1, 0]
 
 
-def fold_curves(params: Params, points: int = 1500) -> pd.DataFrame:
-    """Every fold point carried by the samples of the parallel curve (free lengths of any sign;
-    `physical`: both >= 0), in m and degrees; the geometry's own L01, L02 are not used."""
-    pose = parallel_samples(params, points)
-    g1, g2 = pose[:, 0], pose[:, 1]
+def _line_terms(params: Params, g1: np.ndarray, g2: np.ndarray) -> tuple:
+    """At poses on the parallel curve: d, the line's slope dl/dt, H(0), dH/dt and the
+    coefficients c1, c2 of det H(t) = c1 t + c2 t^2 (its constant term, det of a rank-one
+    matrix, is zero: t = 0, the relaxed equilibrium, is always a fold)."""
     angles = (np.cos(g1), np.sin(g1), np.cos(g2), np.sin(g2))
     a, d = generalised_forces(params, g1, g2)
     norms = np.hypot(a[:, 0], a[:, 1])
     u = np.where(norms[0] >= norms[1], a[0] / norms[0], a[1] / norms[1])
     w = np.einsum("ijn,jn->in", a, u)
     k = np.array([params.k1, params.k2])[:, None]
-    slope = np.stack([k[1] * w[1], -k[0] * w[0]])  # dl/dt
+    slope = np.stack([k[1] * w[1], -k[0] * w[0]])
     b = _curvatures(params, angles)
     uu = np.einsum("in,jn->ijn", u, u)
     radial = k * w**2 / d**2
     h0 = radial.sum(axis=0) * uu
     h1 = (radial * slope).sum(axis=0) * uu - np.einsum("in,ijmn->jmn", k * slope, b)
-    c0, c2 = _det(h0), _det(h1)
-    c1 = _det(h0 + h1) - c0 - c2
+    c2 = _det(h1)
+    c1 = _det(h0 + h1) - _det(h0) - c2
+    return d, slope, h0, h1, c1, c2
+
+
+def tensioned_free_lengths(params: Params, g1, g2) -> np.ndarray:
+    """L0 (shape (2, n)) of the tensioned fold at poses on the parallel curve (NaN if none)."""
+    g1, g2 = np.atleast_1d(np.asarray(g1, float)), np.atleast_1d(np.asarray(g2, float))
+    d, slope, _, _, c1, c2 = _line_terms(params, g1, g2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.where(c2 != 0, -c1 / c2, np.nan)
+    return d * (1 + t * slope)
+
+
+def fold_curves(params: Params, points: int = 1500) -> pd.DataFrame:
+    """Every fold point carried by the samples of the parallel curve (free lengths of any sign;
+    `physical`: both >= 0), in m and degrees, and the cusps found along it; the geometry's own
+    L01, L02 are not used."""
+    pose = parallel_samples(params, points)
+    g1, g2 = pose[:, 0], pose[:, 1]
+    d, slope, h0, h1, c1, c2 = _line_terms(params, g1, g2)
     rows = []
     for n in range(len(g1)):
-        for t in np.roots([c2[n], c1[n], c0[n]]):
-            if abs(t.imag) <= 1e-12 * max(1.0, abs(t)):
-                l0 = d[:, n] * (1 + t.real * slope[:, n])
-                hess = h0[:, :, n] + t.real * h1[:, :, n]
-                eig = np.linalg.eigvalsh(hess)
-                rows.append(
-                    (l0[0], l0[1], g1[n], g2[n], d[0, n], d[1, n], eig[np.argmin(abs(eig))])
-                )
+        roots = [0.0] + ([-c1[n] / c2[n]] if c2[n] != 0 else [])
+        for t in roots:
+            l0 = d[:, n] * (1 + t * slope[:, n])
+            eig = np.linalg.eigvalsh(h0[:, :, n] + t * h1[:, :, n])
+            rows.append((l0[0], l0[1], g1[n], g2[n], d[0, n], d[1, n], eig[np.argmin(abs(eig))]))
     table = _table(rows)
-    return table.assign(curve_id=link_curves(table, params.L3))
+    table = table.assign(curve_id=link_curves(table, params.L3))
+    return pd.concat([table, cusps(params, points)], ignore_index=True)
 
 
 def link_curves(folds: pd.DataFrame, length_scale: float) -> np.ndarray:
@@ -138,3 +154,118 @@ def _table(rows: list[tuple]) -> pd.DataFrame:
         },
         columns=FOLD_COLUMNS,
     )  # fmt: skip
+
+
+def _on_curve(params: Params, fixed: float, guess: float, axis: int) -> float:
+    """The root of a_1 x a_2 in the free angle nearest `guess`, by Newton (rad)."""
+
+    def cross(x):
+        g = (fixed, x) if axis == 0 else (x, fixed)
+        a, _ = generalised_forces(params, *g)
+        return float(a[0, 0] * a[1, 1] - a[0, 1] * a[1, 0])
+
+    x = guess
+    for _ in range(30):
+        h = 1e-7
+        slope = (cross(x + h) - cross(x - h)) / (2 * h)
+        if slope == 0:
+            break
+        step = cross(x) / slope
+        x -= step
+        if abs(step) < 1e-15:
+            break
+    return x
+
+
+def _image(params: Params, g1, g2, family: str) -> np.ndarray:
+    """The fold's free lengths (2, n) at poses on the parallel curve, for one family."""
+    if family == "relaxed":
+        return generalised_forces(params, np.atleast_1d(g1), np.atleast_1d(g2))[1]
+    return tensioned_free_lengths(params, g1, g2)
+
+
+def _image_speed(params, fixed: float, guess: float, axis: int, e: np.ndarray, family: str):
+    """(d L0 / d fixed) . e along the family's fold curve, and the pose's free angle."""
+    h = 1e-6
+    ends = []
+    for f in (fixed - h, fixed + h):
+        x = _on_curve(params, f, guess, axis)
+        g = (f, x) if axis == 0 else (x, f)
+        ends.append(_image(params, *g, family)[:, 0])
+    return float(np.dot(ends[1] - ends[0], e) / (2 * h)), _on_curve(params, fixed, guess, axis)
+
+
+def cusps(params: Params, points: int = 1500) -> pd.DataFrame:
+    """Cusps of the fold curves: where the fold point stops and turns back as its pose moves
+    along the parallel curve (d L0 / ds = 0), found where consecutive samples turn by more than
+    120 deg and refined by bisection on the speed along the incoming direction."""
+    grid = np.linspace(-np.pi, np.pi, points, endpoint=False)
+    found = []
+    for axis in (0, 1):
+        fixed, free = parallel_roots(params, grid, axis=axis)
+        for branch in _branches(fixed, free, grid):
+            g = (fixed[branch], free[branch]) if axis == 0 else (free[branch], fixed[branch])
+            for family in ("relaxed", "tensioned"):
+                step = np.diff(_image(params, *g, family), axis=1)
+                norm = np.hypot(*step)
+                dots = np.einsum("in,in->n", step[:, :-1], step[:, 1:])
+                for k in np.flatnonzero(dots < -0.5 * norm[:-1] * norm[1:]):
+                    pose = _refine_cusp(params, fixed[branch], free[branch], k, step, axis, family)
+                    if pose is not None:
+                        found.append((*pose, family))
+    return _cusp_table(params, found)
+
+
+def _branches(fixed: np.ndarray, free: np.ndarray, grid: np.ndarray) -> list[np.ndarray]:
+    """Indices of the roots chained from one grid value to the next (nearest root within
+    2 deg), so each chain follows one smooth branch of the curve as a graph over `fixed`."""
+    by_value = {v: np.flatnonzero(fixed == v) for v in grid}
+    chains, open_chains = [], {}
+    for v in grid:
+        nxt = {}
+        for idx in by_value[v]:
+            prev = min(open_chains, key=lambda j: abs(free[j] - free[idx]), default=None)
+            if prev is not None and abs(free[prev] - free[idx]) < np.radians(2.0):
+                chain = open_chains.pop(prev)
+            else:
+                chain = []
+                chains.append(chain)
+            chain.append(idx)
+            nxt[idx] = chain
+        open_chains = nxt
+    return [np.array(c) for c in chains if len(c) >= 3]
+
+
+def _refine_cusp(params, fixed, free, k: int, step: np.ndarray, axis: int, family: str):
+    """Bisection between samples k and k + 2 on the image speed along the incoming direction."""
+    e = step[:, k] / np.hypot(*step[:, k])
+    lo, hi = fixed[k], fixed[k + 2]
+    s_lo, _ = _image_speed(params, lo, free[k], axis, e, family)
+    s_hi, _ = _image_speed(params, hi, free[k + 2], axis, e, family)
+    if np.sign(s_lo) == np.sign(s_hi):
+        return None
+    guess = free[k + 1]
+    for _ in range(50):
+        mid = 0.5 * (lo + hi)
+        s_mid, guess = _image_speed(params, mid, guess, axis, e, family)
+        lo, hi, s_lo = (mid, hi, s_mid) if np.sign(s_mid) == np.sign(s_lo) else (lo, mid, s_lo)
+    x = _on_curve(params, 0.5 * (lo + hi), guess, axis)
+    g = (0.5 * (lo + hi), x) if axis == 0 else (x, 0.5 * (lo + hi))
+    return g
+
+
+def _cusp_table(params: Params, poses: list[tuple]) -> pd.DataFrame:
+    """Cusp rows (kind `cusp`), one per distinct pose (the two samplings find some twice)."""
+    rows, seen, families = [], [], []
+    for g1, g2, family in poses:
+        key = np.degrees([g1, g2]) % 360.0
+        if any(np.abs((key - s + 180) % 360 - 180).max() < 0.05 for s in seen):
+            continue  # the same cusp, found from both samplings
+        seen.append(key)
+        families.append(family)
+        d, slope, h0, h1, c1, c2 = _line_terms(params, np.array([g1]), np.array([g2]))
+        t = 0.0 if family == "relaxed" else -c1[0] / c2[0]
+        l0 = d[:, 0] * (1 + t * slope[:, 0])
+        eig = np.linalg.eigvalsh(h0[:, :, 0] + t * h1[:, :, 0])
+        rows.append((l0[0], l0[1], g1, g2, d[0, 0], d[1, 0], eig[np.argmin(abs(eig))]))
+    return _table(rows).assign(kind="cusp", family=families, curve_id=-1)

@@ -90,9 +90,11 @@ def design_map(
     sw = sweep(params, "L01", xs, settings, param2="L02", values2=ys, workers=workers,
                progress=progress)  # fmt: skip
     regions = _counts(sw.table, xs, ys)
+    pieces = int(folds.curve_id[folds.curve_id >= 0].nunique())
     record = {
         "params": params.as_dict(), "window": {"L01": list(l01), "L02": list(l02)},
-        "points": points, "fold_points": len(folds), "fold_curves": int(folds.curve_id.nunique()),
+        "points": points, "fold_points": len(folds), "fold_curves": pieces,
+        "cusps": int((folds.kind == "cusp").sum()),
         "timings": {"folds": t_folds, "regions": time.perf_counter() - t0 - t_folds},
         "sweep_folder": str(sw.folder), "sweep_status": sw.status, "command": sys.argv[:],
     }  # fmt: skip

@@ -275,7 +275,9 @@ def design_map(args: argparse.Namespace) -> int:
     link_latest(root, folder)
     counts = found.regions.stable.value_counts().sort_index()
     spread = ", ".join(f"{n} stable: {c} points" for n, c in counts.items())
-    print(f"map: {len(found.folds)} fold points on {found.record['fold_curves']} pieces; {spread}")
+    cusps = int((found.folds.kind == "cusp").sum())
+    pieces = found.record["fold_curves"]
+    print(f"map: {len(found.folds)} fold points on {pieces} pieces, {cusps} cusps; {spread}")
     print(_files_line(folder))
     return EXIT_OK if found.record["sweep_status"] == "ok" else EXIT_INCOMPLETE
 

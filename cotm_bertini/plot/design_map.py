@@ -10,6 +10,7 @@ import pandas as pd
 from matplotlib import colormaps
 from matplotlib.colors import BoundaryNorm, ListedColormap
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 
 from ..params import CASES, Params
 from .common import describe, save
@@ -17,7 +18,7 @@ from .common import describe, save
 
 def map_figure(params: Params, regions: pd.DataFrame, folds: pd.DataFrame) -> Figure:
     """Stable counts as coloured cells (gid `regions`), fold points (gids `fold-relaxed`,
-    `fold-tensioned`) and the paper's cases (gid `cases`)."""
+    `fold-tensioned`), cusps (gid `cusps`) and the paper's cases (gid `cases`)."""
     fig = Figure(figsize=(8.4, 7.2), layout="constrained")
     ax = fig.subplots()
     x, y = np.unique(regions.L01), np.unique(regions.L02)
@@ -28,10 +29,15 @@ def map_figure(params: Params, regions: pd.DataFrame, folds: pd.DataFrame) -> Fi
     norm = BoundaryNorm(np.arange(-0.5, levels), cmap.N)
     mesh = ax.pcolormesh(x, y, grid, cmap=cmap, norm=norm, shading="nearest", gid="regions")
     fig.colorbar(mesh, ax=ax, ticks=range(levels), label="stable equilibria")
+    handles = []
     for family, colour in (("relaxed", "#d95f02"), ("tensioned", "#e7298a")):
-        f = folds[folds.family == family]
-        ax.plot(f.L01, f.L02, ".", ms=1.2, color=colour, gid=f"fold-{family}",
-                label=f"fold ({family} equilibria)")  # fmt: skip
+        f = folds[(folds.family == family) & (folds.kind == "fold")]
+        ax.plot(f.L01, f.L02, ".", ms=1.2, color=colour, gid=f"fold-{family}")
+        handles.append(Line2D([], [], marker="o", ls="", ms=5, color=colour,
+                              label=f"fold ({family} equilibria)"))  # fmt: skip
+    cusp = folds[folds.kind == "cusp"]
+    (marks,) = ax.plot(cusp.L01, cusp.L02, "kv", ms=6, mfc="white", gid="cusps", label="cusp")
+    handles.append(marks)
     for name, case in CASES.items():
         l01, l02 = case["L01"], case["L02"]
         ax.plot(l01, l02, "k*", ms=11, mfc="yellow", gid="cases")
@@ -44,7 +50,7 @@ def map_figure(params: Params, regions: pd.DataFrame, folds: pd.DataFrame) -> Fi
     geometry = [s for s in describe(params).split(", ") if not s.startswith(("L01", "L02"))]
     ax.set_title("Stable equilibria over the free lengths, with the fold curves\n"
                  + ", ".join(geometry), fontsize=10)  # fmt: skip
-    ax.legend(loc="upper right", fontsize=8, markerscale=8)
+    ax.legend(handles=handles, loc="upper right", fontsize=8)
     return fig
 
 

@@ -6,7 +6,10 @@ import datetime as dt
 import json
 import os
 import secrets
+import shutil
 import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 from .errors import ParameterError
@@ -98,6 +101,20 @@ def new_run_folder(root: Path) -> Path:
 def partial_name(final: Path) -> Path:
     """The hidden working name of a folder that is renamed to `final` when complete."""
     return final.with_name(f".partial-{final.name}")
+
+
+@contextmanager
+def new_folder(dest: str | Path) -> Iterator[Path]:
+    """Build the new folder `dest` under its hidden partial name; renamed to `dest` only when
+    the block ends without error, so a failure never leaves a half-written `dest`."""
+    dest = Path(dest)
+    if dest.exists():
+        raise FileExistsError(f"{dest} exists: results are written to a new folder")
+    work = partial_name(dest)
+    shutil.rmtree(work, ignore_errors=True)
+    work.mkdir(parents=True)
+    yield work
+    work.rename(dest)
 
 
 def link_latest(root: Path, final: Path) -> None:

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import shutil
 import sys
 import time
 from dataclasses import dataclass, field
@@ -12,7 +11,7 @@ from pathlib import Path
 import pandas as pd
 
 from ..columns import reference
-from ..fs import atomic_write_text, partial_name, write_csv
+from ..fs import atomic_write_text, new_folder, write_csv
 from ..params import Params
 from .solutions import Solutions
 
@@ -57,21 +56,15 @@ class Barriers:
     def save(self, folder: str | Path, plots: bool = True) -> Path:
         """barriers.csv, columns.md, barriers.json [, barriers.png/svg] in a new folder, built
         under a hidden name and renamed when complete."""
-        dest = Path(folder)
-        if dest.exists():
-            raise FileExistsError(f"{dest} exists: barriers are written to a new folder")
-        work = partial_name(dest)
-        shutil.rmtree(work, ignore_errors=True)
-        work.mkdir(parents=True)
-        write_csv(work / BARRIERS_CSV, self.table)
-        atomic_write_text(work / "columns.md", reference("barriers"))
-        record = {"params": self.params.as_dict(), "seconds": self.seconds,
-                  "warnings": self.warnings, "command": sys.argv[:]}  # fmt: skip
-        atomic_write_text(work / "barriers.json", json.dumps(record, indent=2))
-        if plots:
-            self.plot(work / "barriers")
-        work.rename(dest)
-        return dest
+        with new_folder(folder) as work:
+            write_csv(work / BARRIERS_CSV, self.table)
+            atomic_write_text(work / "columns.md", reference("barriers"))
+            record = {"params": self.params.as_dict(), "seconds": self.seconds,
+                      "warnings": self.warnings, "command": sys.argv[:]}  # fmt: skip
+            atomic_write_text(work / "barriers.json", json.dumps(record, indent=2))
+            if plots:
+                self.plot(work / "barriers")
+        return Path(folder)
 
 
 def barriers(res: Solutions) -> Barriers:

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import shutil
 import sys
 import time
 from dataclasses import dataclass
@@ -14,7 +13,7 @@ import pandas as pd
 
 from ..columns import reference
 from ..errors import ParameterError
-from ..fs import atomic_write_text, partial_name, write_csv, write_json
+from ..fs import atomic_write_text, new_folder, write_csv, write_json
 from ..params import Params
 from ..settings import Settings
 
@@ -39,20 +38,14 @@ class DesignMap:
     def save(self, folder: str | Path, plots: bool = True) -> Path:
         """folds.csv, regions.csv, columns.md, run.json [, map.png/svg] in a new folder, built
         under a hidden name and renamed when complete."""
-        dest = Path(folder)
-        if dest.exists():
-            raise FileExistsError(f"{dest} exists: a map is written to a new folder")
-        work = partial_name(dest)
-        shutil.rmtree(work, ignore_errors=True)
-        work.mkdir(parents=True)
-        write_csv(work / "folds.csv", self.folds)
-        write_csv(work / "regions.csv", self.regions)
-        atomic_write_text(work / "columns.md", reference("folds", "regions"))
-        if plots:
-            self.plot(work / "map")
-        write_json(work / "run.json", self.record)
-        work.rename(dest)
-        return dest
+        with new_folder(folder) as work:
+            write_csv(work / "folds.csv", self.folds)
+            write_csv(work / "regions.csv", self.regions)
+            atomic_write_text(work / "columns.md", reference("folds", "regions"))
+            if plots:
+                self.plot(work / "map")
+            write_json(work / "run.json", self.record)
+        return Path(folder)
 
 
 def _window(name: str, lo: float, hi: float, points: int) -> None:

@@ -25,7 +25,9 @@ def main() -> None:
     phys = folds[folds.physical & folds.L01.between(0, 14) & folds.L02.between(0, 14)]
     print("== fold curves of the paper geometry (target: under 60 s) ==")
     print(f"  {seconds:.2f} s for {len(folds)} fold points ({len(phys)} physical in (0, 14]^2),")
-    print(f"  {1e6 * seconds / len(folds):.0f} us a fold point, {folds.curve_id.nunique()} pieces")
+    pieces = folds.curve_id[folds.curve_id >= 0].nunique()
+    cusps = int((folds.kind == "cusp").sum())
+    print(f"  {1e6 * seconds / len(folds):.0f} us a fold point, {pieces} pieces, {cusps} cusps")
     t0 = time.perf_counter()
     m = cb.design_map(p, (0.0, 14.0), (0.0, 14.0), args.points, workers=2)
     seconds = time.perf_counter() - t0

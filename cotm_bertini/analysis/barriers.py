@@ -17,8 +17,9 @@ import numpy as np
 import pandas as pd
 
 from ..model.compiled import energy, energy_gradient, energy_hessian
-from ..model.kinematics import spring_vectors
 from ..params import Params
+from .critical_points import deg_distance
+from .design import generalised_forces
 
 KICK = 1e-3  # rad: the first step off the saddle, along the unstable eigenvector
 MAX_STEP = 0.02  # rad
@@ -36,9 +37,8 @@ class Descent:
     min_spring_length: float  # m, along the path
 
 
-def _spring_lengths(params: Params, x: np.ndarray) -> np.ndarray:
-    vec = spring_vectors(params, np.cos(x[0]), np.sin(x[0]), np.cos(x[1]), np.sin(x[1]))
-    return np.array([np.hypot(*vec["spring1"]), np.hypot(*vec["spring2"])])
+def _shortest_spring(params: Params, x: np.ndarray) -> float:
+    return float(generalised_forces(params, x[0], x[1])[1].min())
 
 
 def _newton_step(params: Params, x: np.ndarray, grad: np.ndarray) -> np.ndarray | None:
@@ -52,7 +52,7 @@ def _newton_step(params: Params, x: np.ndarray, grad: np.ndarray) -> np.ndarray 
 def descend(params: Params, start: np.ndarray) -> Descent:
     """Gradient flow of V from `start` (rad) to a minimum."""
     x = np.array(start, dtype=float)
-    path, shortest = [x.copy()], float(_spring_lengths(params, x).min())
+    path, shortest = [x.copy()], _shortest_spring(params, x)
     v, step = float(energy(params, *x)), MAX_STEP
     for _ in range(MAX_STEPS):
         grad = energy_gradient(params, x[0], x[1])[0]
@@ -61,7 +61,7 @@ def descend(params: Params, start: np.ndarray) -> Descent:
             x = x + newton
             v = float(energy(params, *x))
             path.append(x.copy())
-            shortest = min(shortest, float(_spring_lengths(params, x).min()))
+            shortest = min(shortest, _shortest_spring(params, x))
             if np.abs(newton).max() < 1e-13:
                 return Descent(np.array(path), True, shortest)
             continue
@@ -79,13 +79,8 @@ def descend(params: Params, start: np.ndarray) -> Descent:
         x, v = trial, vt
         step = min(MAX_STEP, 2 * step)
         path.append(x.copy())
-        shortest = min(shortest, float(_spring_lengths(params, x).min()))
+        shortest = min(shortest, _shortest_spring(params, x))
     return Descent(np.array(path), False, shortest)
-
-
-def _torus_deg(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    diff = (np.asarray(a) - np.asarray(b) + 180.0) % 360.0 - 180.0
-    return np.abs(diff).max(axis=-1)
 
 
 def _match(end: np.ndarray, minima: pd.DataFrame) -> int | None:
@@ -93,7 +88,7 @@ def _match(end: np.ndarray, minima: pd.DataFrame) -> int | None:
     if minima.empty:
         return None
     angles = minima[["gamma1_deg", "gamma2_deg"]].to_numpy(float)
-    dist = _torus_deg(np.degrees(end)[None, :], angles)
+    dist = deg_distance(np.degrees(end), angles)
     k = int(np.argmin(dist))
     return int(minima.solution_id.iloc[k]) if dist[k] < MATCH_DEG else None
 

@@ -84,13 +84,13 @@ def compare_physical(found: pd.DataFrame, solutions: pd.DataFrame) -> dict:
     b = phys[["gamma1_deg", "gamma2_deg"]].to_numpy()
     worst, missing_in_b, missing_in_a = 0.0, 0, 0
     for p in a:
-        d = _deg_distance(p, b)
+        d = deg_distance(p, b)
         if d.size == 0 or d.min() > 1e-4:
             missing_in_b += 1
         else:
             worst = max(worst, float(d.min()))
     for q in b:
-        d = _deg_distance(q, a)
+        d = deg_distance(q, a)
         if d.size == 0 or d.min() > 1e-4:
             missing_in_a += 1
     return {
@@ -102,7 +102,8 @@ def compare_physical(found: pd.DataFrame, solutions: pd.DataFrame) -> dict:
     }
 
 
-def _deg_distance(p: np.ndarray, rows: np.ndarray) -> np.ndarray:
+def deg_distance(p: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """The largest angle difference (deg, on the torus) between point p and each row."""
     if rows.size == 0:
         return np.array([])
     d = np.abs(rows - p) % 360.0

@@ -64,12 +64,22 @@ def generalised_forces(params: Params, g1, g2) -> tuple[np.ndarray, np.ndarray]:
     return a, d
 
 
-def parallel_sine(params: Params, g1, g2) -> np.ndarray:
-    """a_1 x a_2 / (|a_1| |a_2|): zero on the curve where tensioned springs can hold the pose."""
-    a, _ = generalised_forces(params, g1, g2)
+def _sine(a: np.ndarray) -> np.ndarray:
+    """a_1 x a_2 / (|a_1| |a_2|) of generalised forces `a`."""
     cross = a[0, 0] * a[1, 1] - a[0, 1] * a[1, 0]
     with np.errstate(divide="ignore", invalid="ignore"):
         return cross / (np.hypot(*a[0]) * np.hypot(*a[1]))
+
+
+def parallel_sine(params: Params, g1, g2) -> np.ndarray:
+    """a_1 x a_2 / (|a_1| |a_2|): zero on the curve where tensioned springs can hold the pose."""
+    return _sine(generalised_forces(params, g1, g2)[0])
+
+
+def parallel_cross(params: Params, g1, g2) -> np.ndarray:
+    """a_1 x a_2: its zero set is the parallel curve."""
+    a, _ = generalised_forces(params, g1, g2)
+    return a[0, 0] * a[1, 1] - a[0, 1] * a[1, 0]
 
 
 def design(
@@ -92,7 +102,7 @@ def design(
             raise ParameterError(
                 f"{where}: spring {i + 1} has zero length there, so its pull has no direction"
             )
-    if abs(float(parallel_sine(params, g1, g2))) > PARALLEL:
+    if abs(float(_sine(a))) > PARALLEL:
         curve = parallel_curve(params, gamma1_deg) if (L01, L02) != (None, None) else []
         l0 = _relaxed(d, L01, L02, where, curve)
         family = "relaxed"
@@ -165,11 +175,6 @@ def _assess(params: Params, g1_deg: float, g2_deg: float, l0, d, family: str) ->
     )  # fmt: skip
 
 
-def _cross(params: Params, g1, g2) -> np.ndarray:
-    a, _ = generalised_forces(params, g1, g2)
-    return a[0, 0] * a[1, 1] - a[0, 1] * a[1, 0]
-
-
 def parallel_roots(
     params: Params, fixed: np.ndarray, axis: int = 0, samples: int = 1440
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -181,7 +186,7 @@ def parallel_roots(
     F, G = np.meshgrid(fixed, grid, indexing="ij")
 
     def cross(f, g):
-        return _cross(params, f, g) if axis == 0 else _cross(params, g, f)
+        return parallel_cross(params, f, g) if axis == 0 else parallel_cross(params, g, f)
 
     vals = cross(F, G)
     i, j = np.nonzero(np.sign(vals[:, :-1]) != np.sign(vals[:, 1:]))

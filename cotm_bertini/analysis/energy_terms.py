@@ -28,6 +28,12 @@ def _spring_terms(p: Any, angles: tuple, hessian: bool) -> list[tuple]:
     return out
 
 
+def curvature(pv, first, second, j: int, m: int) -> Any:
+    """B_jm = P_j . P_m + P . P_jm of one spring (`second` = (P_11, P_12, P_22))."""
+    curv = ((second[0], second[1]), (second[1], second[2]))
+    return dot(first[j], first[m]) + dot(pv, curv[j][m])
+
+
 def gradient_hessian(p: Any, angles: tuple, sqrt, hessian: bool = True, zero: Any = 0.0):
     """(grad, Hessian or None) of V at c1, s1, c2, s2 = `angles`; `sqrt` of the arithmetic used.
 
@@ -43,10 +49,9 @@ def gradient_hessian(p: Any, angles: tuple, sqrt, hessian: bool = True, zero: An
         for j in (0, 1):
             grad[j] = grad[j] + weight * proj[j]
         if hessian:
-            curv = ((second[0], second[1]), (second[1], second[2]))
             for j in (0, 1):
                 for m in (0, 1):
-                    term = weight * (dot(first[j], first[m]) + dot(pv, curv[j][m]))
+                    term = weight * curvature(pv, first, second, j, m)
                     if not zfl:
                         term = term + k * ratio / dd * proj[j] * proj[m]
                     hess[j][m] = hess[j][m] + term

@@ -14,12 +14,16 @@ closed form.
 
 from __future__ import annotations
 
+from itertools import product
+
 import numpy as np
 import pandas as pd
 
-from ..model.kinematics import dot, spring_jacobian, spring_second_derivatives, spring_vectors
+from ..model.kinematics import spring_jacobian, spring_second_derivatives, spring_vectors
 from ..params import Params
-from .design import generalised_forces, parallel_roots
+from .critical_points import deg_distance
+from .design import generalised_forces, parallel_cross, parallel_roots
+from .energy_terms import curvature
 
 FOLD_COLUMNS = [
     "L01", "L02", "gamma1_deg", "gamma2_deg", "d1", "d2", "physical", "family", "curve_id",
@@ -29,13 +33,20 @@ LINK_DEG = 1.0  # fold points whose poses differ by less than this ...
 LINK_LENGTH = 0.05  # ... and whose free lengths differ by less than this times L3 are linked
 
 
-def parallel_samples(params: Params, points: int = 1500) -> np.ndarray:
-    """Points (rad, shape (n, 2)) of the parallel curve: for `points` values of each angle, the
-    other angle's roots."""
-    grid = np.linspace(-np.pi, np.pi, points, endpoint=False)
-    g1, r2 = parallel_roots(params, grid, axis=0)
-    g2, r1 = parallel_roots(params, grid, axis=1)  # (the fixed gamma2, the gamma1 roots)
-    return np.vstack([np.c_[g1, r2], np.c_[r1, g2]])
+def _grid(points: int) -> np.ndarray:
+    return np.linspace(-np.pi, np.pi, points, endpoint=False)
+
+
+def parallel_samples(params: Params, points: int = 1500) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The parallel curve sampled: for axis 0, (gamma1 on a grid of `points`, the gamma2 roots);
+    for axis 1, (gamma2 on the grid, the gamma1 roots), in rad."""
+    return [parallel_roots(params, _grid(points), axis=axis) for axis in (0, 1)]
+
+
+def _poses(samples: list[tuple[np.ndarray, np.ndarray]]) -> tuple[np.ndarray, np.ndarray]:
+    """(gamma1, gamma2) of every sample."""
+    (g1, r2), (g2, r1) = samples
+    return np.concatenate([g1, r1]), np.concatenate([r2, g2])
 
 
 def _curvatures(params: Params, angles: tuple) -> np.ndarray:
@@ -44,11 +55,9 @@ def _curvatures(params: Params, angles: tuple) -> np.ndarray:
     out = np.zeros((2, 2, 2, len(angles[0])))
     for i in (0, 1):
         pv, first = vec[f"spring{i + 1}"], spring_jacobian(params, i + 1, *angles)
-        s11, s12, s22 = spring_second_derivatives(params, i + 1, *angles)
-        curv = ((s11, s12), (s12, s22))
-        for j in (0, 1):
-            for m in (0, 1):
-                out[i, j, m] = dot(first[j], first[m]) + dot(pv, curv[j][m])
+        second = spring_second_derivatives(params, i + 1, *angles)
+        for j, m in product((0, 1), repeat=2):
+            out[i, j, m] = curvature(pv, first, second, j, m)
     return out
 
 
@@ -86,23 +95,29 @@ def tensioned_free_lengths(params: Params, g1, g2) -> np.ndarray:
     return d * (1 + t * slope)
 
 
+def _fold_row(terms: tuple, n: int, t: float, g1: float, g2: float) -> tuple:
+    """(L01, L02, gamma1, gamma2, d1, d2, Hessian eigenvalue nearest 0) at root t of pose n."""
+    d, slope, h0, h1, _, _ = terms
+    l0 = d[:, n] * (1 + t * slope[:, n])
+    eig = np.linalg.eigvalsh(h0[:, :, n] + t * h1[:, :, n])
+    return (l0[0], l0[1], g1, g2, d[0, n], d[1, n], eig[np.argmin(abs(eig))])
+
+
 def fold_curves(params: Params, points: int = 1500) -> pd.DataFrame:
     """Every fold point carried by the samples of the parallel curve (free lengths of any sign;
     `physical`: both >= 0), in m and degrees, and the cusps found along it; the geometry's own
     L01, L02 are not used."""
-    pose = parallel_samples(params, points)
-    g1, g2 = pose[:, 0], pose[:, 1]
-    d, slope, h0, h1, c1, c2 = _line_terms(params, g1, g2)
+    samples = parallel_samples(params, points)
+    g1, g2 = _poses(samples)
+    terms = _line_terms(params, g1, g2)
+    c1, c2 = terms[4], terms[5]
     rows = []
     for n in range(len(g1)):
-        roots = [0.0] + ([-c1[n] / c2[n]] if c2[n] != 0 else [])
-        for t in roots:
-            l0 = d[:, n] * (1 + t * slope[:, n])
-            eig = np.linalg.eigvalsh(h0[:, :, n] + t * h1[:, :, n])
-            rows.append((l0[0], l0[1], g1[n], g2[n], d[0, n], d[1, n], eig[np.argmin(abs(eig))]))
+        for t in [0.0] + ([-c1[n] / c2[n]] if c2[n] != 0 else []):
+            rows.append(_fold_row(terms, n, t, g1[n], g2[n]))
     table = _table(rows)
     table = table.assign(curve_id=link_curves(table, params.L3))
-    return pd.concat([table, cusps(params, points)], ignore_index=True)
+    return pd.concat([table, _cusps(params, samples, _grid(points))], ignore_index=True)
 
 
 def link_curves(folds: pd.DataFrame, length_scale: float) -> np.ndarray:
@@ -125,13 +140,18 @@ def link_curves(folds: pd.DataFrame, length_scale: float) -> np.ndarray:
 
     wrap = int(round(360 / LINK_DEG))
     for n, (a, b) in enumerate(keys):
-        for da in (-1, 0, 1):
-            for db in (-1, 0, 1):
-                for m in cells.get(((a + da) % wrap, (b + db) % wrap), ()):
-                    gap = np.abs((pose[n] - pose[m] + 180) % 360 - 180).max()
-                    near = np.abs(l0[n] - l0[m]).max() < LINK_LENGTH * length_scale
-                    if m > n and fam[m] == fam[n] and gap < LINK_DEG and near:
-                        parent[root(m)] = root(n)
+        near = [m for da, db in product((-1, 0, 1), repeat=2)
+                for m in cells.get(((a + da) % wrap, (b + db) % wrap), ()) if m > n]  # fmt: skip
+        near = np.array(near, dtype=int)
+        if near.size == 0:
+            continue
+        linked = (
+            (fam[near] == fam[n])
+            & (deg_distance(pose[n], pose[near]) < LINK_DEG)
+            & (np.abs(l0[near] - l0[n]).max(axis=1) < LINK_LENGTH * length_scale)
+        )
+        for m in near[linked]:
+            parent[root(m)] = root(n)
     roots = np.array([root(n) for n in range(len(folds))])
     _, ids = np.unique(roots, return_inverse=True)
     return ids
@@ -160,9 +180,9 @@ def _on_curve(params: Params, fixed: float, guess: float, axis: int) -> float:
     """The root of a_1 x a_2 in the free angle nearest `guess`, by Newton (rad)."""
 
     def cross(x):
-        g = (fixed, x) if axis == 0 else (x, fixed)
-        a, _ = generalised_forces(params, *g)
-        return float(a[0, 0] * a[1, 1] - a[0, 1] * a[1, 0])
+        return float(
+            parallel_cross(params, fixed, x) if axis == 0 else parallel_cross(params, x, fixed)
+        )
 
     x = guess
     for _ in range(30):
@@ -195,14 +215,12 @@ def _image_speed(params, fixed: float, guess: float, axis: int, e: np.ndarray, f
     return float(np.dot(ends[1] - ends[0], e) / (2 * h)), _on_curve(params, fixed, guess, axis)
 
 
-def cusps(params: Params, points: int = 1500) -> pd.DataFrame:
+def _cusps(params: Params, samples: list, grid: np.ndarray) -> pd.DataFrame:
     """Cusps of the fold curves: where the fold point stops and turns back as its pose moves
     along the parallel curve (d L0 / ds = 0), found where consecutive samples turn by more than
     120 deg and refined by bisection on the speed along the incoming direction."""
-    grid = np.linspace(-np.pi, np.pi, points, endpoint=False)
     found = []
-    for axis in (0, 1):
-        fixed, free = parallel_roots(params, grid, axis=axis)
+    for axis, (fixed, free) in enumerate(samples):
         for branch in _branches(fixed, free, grid):
             g = (fixed[branch], free[branch]) if axis == 0 else (free[branch], fixed[branch])
             for family in ("relaxed", "tensioned"):
@@ -250,8 +268,7 @@ def _refine_cusp(params, fixed, free, k: int, step: np.ndarray, axis: int, famil
         s_mid, guess = _image_speed(params, mid, guess, axis, e, family)
         lo, hi, s_lo = (mid, hi, s_mid) if np.sign(s_mid) == np.sign(s_lo) else (lo, mid, s_lo)
     x = _on_curve(params, 0.5 * (lo + hi), guess, axis)
-    g = (0.5 * (lo + hi), x) if axis == 0 else (x, 0.5 * (lo + hi))
-    return g
+    return (0.5 * (lo + hi), x) if axis == 0 else (x, 0.5 * (lo + hi))
 
 
 def _cusp_table(params: Params, poses: list[tuple]) -> pd.DataFrame:
@@ -259,13 +276,11 @@ def _cusp_table(params: Params, poses: list[tuple]) -> pd.DataFrame:
     rows, seen, families = [], [], []
     for g1, g2, family in poses:
         key = np.degrees([g1, g2]) % 360.0
-        if any(np.abs((key - s + 180) % 360 - 180).max() < 0.05 for s in seen):
+        if seen and deg_distance(key, np.array(seen)).min() < 0.05:
             continue  # the same cusp, found from both samplings
         seen.append(key)
         families.append(family)
-        d, slope, h0, h1, c1, c2 = _line_terms(params, np.array([g1]), np.array([g2]))
-        t = 0.0 if family == "relaxed" else -c1[0] / c2[0]
-        l0 = d[:, 0] * (1 + t * slope[:, 0])
-        eig = np.linalg.eigvalsh(h0[:, :, 0] + t * h1[:, :, 0])
-        rows.append((l0[0], l0[1], g1, g2, d[0, 0], d[1, 0], eig[np.argmin(abs(eig))]))
+        terms = _line_terms(params, np.array([g1]), np.array([g2]))
+        t = 0.0 if family == "relaxed" else -terms[4][0] / terms[5][0]
+        rows.append(_fold_row(terms, 0, t, g1, g2))
     return _table(rows).assign(kind="cusp", family=families, curve_id=-1)

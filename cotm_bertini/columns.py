@@ -98,7 +98,7 @@ REGIONS = {
 }
 
 DESIGN = {
-    "gamma1_deg, gamma2_deg": "the pose asked for (deg)",
+    "gamma1_deg, gamma2_deg": "the pose asked for (deg), in [0, 360)",
     "L01, L02": "the free lengths (m) holding the pose in equilibrium (may be negative: then not "
     "physical)",
     "d1, d2": "the spring lengths (m) at the pose",

@@ -55,9 +55,20 @@ LENGTHS = ("L3", "p2x", "p3x", "p3y", "p6x", "p5x", "p5y", "L01", "L02")
 _COINCIDENT_REL = 1e-9
 
 
+def check_names(given: dict[str, object], known: tuple[str, ...], what: str) -> None:
+    """Refuse an unknown keyword with ParameterError naming it and listing the known ones."""
+    for name in given:
+        if name not in known:
+            raise ParameterError(f"{name}: unknown {what} (known: {' '.join(known)})")
+
+
 @dataclass(frozen=True)
 class Params:
-    """Geometry, stiffness and free lengths of the CoTM (metres, N/m); unset fields: Table 1."""
+    """Geometry, stiffness and free lengths of the CoTM (metres, N/m).
+
+    Unset fields are Table 1 as printed, L01 = L02 = 0 (= case1): the same rule as every
+    command line without a case (docs/cli.md).
+    """
 
     L3: float = TABLE1["L3"]
     k1: float = TABLE1["k1"]
@@ -70,6 +81,20 @@ class Params:
     p5y: float = TABLE1["p5y"]
     L01: float = TABLE1["L01"]
     L02: float = TABLE1["L02"]
+
+    def __new__(cls, *args: float, **values: float) -> Params:
+        """Refuse an unknown or repeated field with ParameterError (not a bare TypeError)."""
+        if len(args) > len(PARAM_NAMES):
+            raise ParameterError(
+                f"Params takes at most {len(PARAM_NAMES)} values ({' '.join(PARAM_NAMES)}), "
+                f"got {len(args)}"
+            )
+        check_names(values, PARAM_NAMES, "parameter")
+        twice = set(PARAM_NAMES[: len(args)]) & set(values)
+        if twice:
+            name = sorted(twice)[0]
+            raise ParameterError(f"{name} = {values[name]!r}: given twice (by position and name)")
+        return super().__new__(cls)
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -148,8 +173,7 @@ def _check_distinct_points(p: Params, tol: float) -> None:
 
 def coerce(name: str, value: object) -> float:
     """One parameter value as a float; ParameterError names the field and the value."""
-    if name not in PARAM_NAMES:
-        raise ParameterError(f"{name}: unknown parameter (known: {' '.join(PARAM_NAMES)})")
+    check_names({name: value}, PARAM_NAMES, "parameter")
     if isinstance(value, bool) or not isinstance(value, int | float | str):
         raise ParameterError(f"{name} = {value!r}: must be a number")
     try:
@@ -167,18 +191,19 @@ def parse_assignment(text: str) -> tuple[str, float]:
     return name, coerce(name, value.strip())
 
 
-def load_toml(path: str | Path) -> dict[str, float]:
-    """Read a TOML file of top-level parameter values (any subset of PARAM_NAMES)."""
+def load_toml(path: str | Path, option: str = "path") -> dict[str, float]:
+    """Read a TOML file of top-level parameter values (any subset of PARAM_NAMES); errors name
+    `option` (the Python argument, or the command line's `--params`)."""
     path = Path(path)
     try:
         with path.open("rb") as fh:
             data = tomllib.load(fh)
     except FileNotFoundError:
-        raise ParameterError(f"--params {str(path)!r}: file not found") from None
+        raise ParameterError(f"{option} {str(path)!r}: file not found") from None
     except IsADirectoryError:
-        raise ParameterError(f"--params {str(path)!r}: is a directory, not a file") from None
+        raise ParameterError(f"{option} {str(path)!r}: is a directory, not a file") from None
     except tomllib.TOMLDecodeError as exc:
-        raise ParameterError(f"--params {str(path)!r}: not valid TOML ({exc})") from None
+        raise ParameterError(f"{option} {str(path)!r}: not valid TOML ({exc})") from None
     return {name: coerce(name, value) for name, value in data.items()}
 
 

@@ -58,6 +58,13 @@ class Settings:
     bertini: str | None = None  # path of a Bertini 1.x binary; None: the bundled bertini2
     extra_config: dict[str, str] = field(default_factory=dict)
 
+    def __new__(cls, *args: object, **values: object) -> Settings:
+        """Refuse an unknown setting with ParameterError (not a bare TypeError)."""
+        from .params import check_names
+
+        check_names(values, tuple(sorted(cls.__dataclass_fields__)), "setting")
+        return super().__new__(cls)
+
     def __post_init__(self) -> None:
         _check_types(self)
         if self.engine is None:

@@ -25,6 +25,37 @@ from .energy_terms import gradient_hessian
 PARALLEL = 1e-9  # |a_1 x a_2| / (|a_1| |a_2|) below this: the pose is on the parallel curve
 ZERO_LENGTH = 1e-9  # a spring shorter than this (relative to L3) has no direction
 
+# Unit and meaning of each field of a Design (docs/columns.md, the design CSV).
+FIELDS = {
+    "gamma1_deg": ("deg", "rod angle, in [0, 360)"),
+    "gamma2_deg": ("deg", "top body angle, in [0, 360)"),
+    "L01": ("m", "free length of spring 1 holding the pose"),
+    "L02": ("m", "free length of spring 2 holding the pose"),
+    "d1": ("m", "length of spring 1 at the pose"),
+    "d2": ("m", "length of spring 2 at the pose"),
+    "family": ("", "relaxed (L0 = d, V = 0) or parallel (on the parallel curve)"),
+    "physical": ("", "both free lengths >= 0"),
+    "stable": ("", "physical and the energy Hessian positive definite"),
+    "hess_eig_min": ("J/rad^2", "smallest eigenvalue of the energy Hessian"),
+    "hess_eig_max": ("J/rad^2", "largest eigenvalue of the energy Hessian"),
+    "grad_residual": ("J/rad", "|grad V| at the design: 0 up to rounding"),
+}
+
+
+def wrap_deg(angle: float) -> float:
+    """An angle in degrees as the tool reports angles, in [0, 360)."""
+    w = angle % 360.0
+    return 0.0 if w >= 360.0 else w
+
+
+def _number(name: str, value: object) -> float:
+    """A finite float, or ParameterError naming the argument and the value."""
+    if isinstance(value, bool) or not isinstance(value, int | float | np.floating | np.integer):
+        raise ParameterError(f"{name} = {value!r}: must be a number")
+    if not math.isfinite(value):
+        raise ParameterError(f"{name} = {value!r}: must be finite")
+    return float(value)
+
 
 @dataclass(frozen=True)
 class Design:
@@ -46,6 +77,17 @@ class Design:
     def as_dict(self) -> dict:
         """The CSV row."""
         return asdict(self)
+
+    def as_toml(self) -> str:
+        """The design as TOML, each value with its unit and meaning in a comment."""
+        lines = []
+        for name, value in self.as_dict().items():
+            unit, meaning = FIELDS[name]
+            text = repr(value) if isinstance(value, float) else str(value)
+            text = text.lower() if isinstance(value, bool) else text
+            text = f'"{value}"' if isinstance(value, str) else text
+            lines.append(f"{name} = {text}  # {unit + ', ' if unit else ''}{meaning}")
+        return "\n".join(lines)
 
 
 def generalised_forces(params: Params, g1, g2) -> tuple[np.ndarray, np.ndarray]:
@@ -90,11 +132,15 @@ def design(
     L02: float | None = None,
 ) -> Design:
     """The free lengths holding the pose of `params`' geometry (its own L01, L02 unused) in
-    equilibrium; on the parallel curve pass one of L01, L02. ParameterError where none exists."""
-    for name, value in (("gamma1", gamma1_deg), ("gamma2", gamma2_deg), ("L01", L01), ("L02", L02)):
-        if value is not None and not math.isfinite(value):
-            raise ParameterError(f"{name} must be a finite number, got {value!r}")
-    where = f"gamma1={gamma1_deg:g}, gamma2={gamma2_deg:g}"
+    equilibrium; on the parallel curve pass one of L01, L02. ParameterError where none exists.
+    The angles are reported in [0, 360)."""
+    if not isinstance(params, Params):
+        raise ParameterError(f"params = {params!r}: expected a cb.Params")
+    gamma1_deg = wrap_deg(_number("gamma1_deg", gamma1_deg))
+    gamma2_deg = wrap_deg(_number("gamma2_deg", gamma2_deg))
+    L01 = None if L01 is None else _number("L01", L01)
+    L02 = None if L02 is None else _number("L02", L02)
+    where = f"gamma1 = {gamma1_deg:.12g} deg, gamma2 = {gamma2_deg:.12g} deg"
     g1, g2 = math.radians(gamma1_deg), math.radians(gamma2_deg)
     a, d = generalised_forces(params, g1, g2)
     for i in (0, 1):
@@ -117,12 +163,13 @@ def _relaxed(d: np.ndarray, L01, L02, where: str, curve: list[float]) -> np.ndar
     hint = ""
     if curve:
         hint = "; at this gamma1 the curve passes gamma2 = " + ", ".join(f"{g:.9f}" for g in curve)
+        hint += " deg"
     for i, given in enumerate((L01, L02)):
         if given is not None and abs(given - d[i]) > 1e-12 * max(1.0, d[i]):
             raise ParameterError(
-                f"{where}: L0{i + 1}={given:g} cannot hold this pose: off the curve where the "
+                f"{where}: L0{i + 1}={given:.12g} cannot hold this pose: off the curve where the "
                 f"springs' generalised forces are parallel, only relaxed springs can "
-                f"(L01={d[0]:.12g}, L02={d[1]:.12g}){hint}"
+                f"(L01={d[0]:.12g} m, L02={d[1]:.12g} m){hint}"
             )
     return d.copy()
 
@@ -148,7 +195,7 @@ def _on_parallel_curve(params: Params, a, d, L01, L02, where: str) -> np.ndarray
         if abs(w[given] * (1 - ell[given])) > PARALLEL * max(abs(w[0]), abs(w[1])):
             raise ParameterError(
                 f"{where}: spring {other + 1} exerts no generalised force here, so spring "
-                f"{given + 1} must be relaxed (L0{given + 1}={d[given]:.12g})"
+                f"{given + 1} must be relaxed (L0{given + 1}={d[given]:.12g} m)"
             )
         raise ParameterError(
             f"{where}: spring {other + 1} exerts no generalised force here: any L0{other + 1} "
@@ -200,6 +247,7 @@ def parallel_roots(
 
 
 def parallel_curve(params: Params, gamma1_deg: float, samples: int = 1440) -> list[float]:
-    """The gamma2 (degrees) where the pose (gamma1, gamma2) is on the parallel curve."""
+    """The gamma2 (degrees, in [0, 360), ascending) where the pose (gamma1, gamma2) is on the
+    parallel curve."""
     _, roots = parallel_roots(params, np.array([math.radians(gamma1_deg)]), 0, samples)
-    return [math.degrees(float(r)) for r in np.sort(roots)]
+    return sorted(wrap_deg(math.degrees(float(r))) for r in roots)

@@ -55,7 +55,7 @@ def _window(name: str, lo: float, hi: float, points: int) -> None:
     if not hi > lo:
         raise ParameterError(f"{name}: the range {lo:g} to {hi:g} is empty (need from < to)")
     if points < 2:
-        raise ParameterError(f"--points {points}: a map needs at least 2 points a side")
+        raise ParameterError(f"points = {points!r}: a map needs at least 2 points a side")
 
 
 def design_map(

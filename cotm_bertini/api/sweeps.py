@@ -103,15 +103,16 @@ def sweep(
     it stopped and an unchanged finished sweep is not solved again. With `certify`, every point
     is proved as `cb.certify` proves a solve (columns certified, certified_radius, certificate).
     """
-    from ..continuation.runner import prepare
+    from ..continuation.runner import check_workers, prepare
     from ..continuation.spec import SweepSpec
 
+    check_workers(workers)  # before any folder is made
     settings = (settings or Settings()).replace(**options)
     spec = SweepSpec(
         params.as_dict(), param, tuple(values), param2,
         None if values2 is None else tuple(values2), settings.as_dict(), certify,
     )  # fmt: skip
-    root = cache_root() / "sweeps" if out is None else output_root(out)
+    root = cache_root() / "sweeps" if out is None else output_root(out, "out")
     folder = prepare(spec, root / spec.folder_name())
     return _run(spec, folder, workers, scheduler, progress, command)
 
@@ -139,11 +140,12 @@ def resume_sweep(
     command: list[str] | None = None,
 ) -> Sweep:
     """Continue the sweep stored in `folder` (after an interruption) and finish it."""
-    from ..continuation.runner import load_spec
+    from ..continuation.runner import check_workers, load_spec
 
+    check_workers(workers)
     folder = Path(folder)
     if not folder.is_dir():
-        raise ParameterError(f"--resume {str(folder)!r}: no such folder")
+        raise ParameterError(f"folder {str(folder)!r}: no such folder")
     return _run(load_spec(folder), folder, workers, scheduler, progress, command)
 
 

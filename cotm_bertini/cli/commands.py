@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import shutil
 import sys
 import time
@@ -15,8 +16,8 @@ from .options import (
     EXIT_DISAGREE,
     EXIT_INCOMPLETE,
     EXIT_OK,
+    describe,
     label_of,
-    overrides,
     params_from,
     settings_from,
 )
@@ -54,7 +55,8 @@ def solve(args: argparse.Namespace) -> int:
     folder = res.save(new_run_folder(root), plots=not args.no_plots, command=sys.argv[:])
     link_latest(root, folder)
     _warn(res.warnings)
-    print(folder if args.quiet else f"{label}: {res.summary}\n{_files_line(folder)}")
+    head = f"{label} ({describe(params)}): {res.summary}"
+    print(folder if args.quiet else f"{head}\n{_files_line(folder)}")
     if res.cache_hit:
         print(
             f"cache: answered from a solve of {res.record['cache']['solved']} (key "
@@ -86,8 +88,27 @@ def certify(args: argparse.Namespace) -> int:
     return solve(args)
 
 
+def _check_points(name: str, start: float, stop: float, points: int | None, suffix: str) -> None:
+    """A range needs two points or more, one point needs --from equal to --to (item 2, issue 16)."""
+    if points is None:
+        raise ParameterError(f"--points{suffix} is required with {name}")
+    if points < 1:
+        raise ParameterError(f"--points{suffix} {points}: must be >= 1")
+    if points == 1 and start != stop:
+        raise ParameterError(
+            f"--points{suffix} 1 for {name} from {start:g} to {stop:g}: a range needs at least 2 "
+            f"points (for one value, give --from{suffix} V --to{suffix} V)"
+        )
+    if points > 1 and start == stop:
+        raise ParameterError(
+            f"--from{suffix} {start:g} --to{suffix} {stop:g} for {name}: an empty range cannot "
+            f"hold {points} distinct points (use --points{suffix} 1, or widen the range)"
+        )
+
+
 def _sweep_spec_values(args: argparse.Namespace, which: str) -> tuple[float, ...] | None:
     from ..continuation.spec import DEFAULT_RANGES, linspace
+    from ..params import PARAM_NAMES
 
     suffix = "2" if which == "param2" else ""
     name = getattr(args, which)
@@ -99,6 +120,12 @@ def _sweep_spec_values(args: argparse.Namespace, which: str) -> tuple[float, ...
                     "given without --param2"
                 )
         return None
+    if name not in PARAM_NAMES:
+        raise ParameterError(
+            f"--{which} {name!r}: unknown parameter (known: {' '.join(PARAM_NAMES)})"
+        )
+    if suffix and name == args.param:
+        raise ParameterError(f"--param2 {name!r}: same as --param")
     start, stop = getattr(args, "start" + suffix), getattr(args, "stop" + suffix)
     points = getattr(args, "points" + suffix)
     if start is None or stop is None:
@@ -110,8 +137,7 @@ def _sweep_spec_values(args: argparse.Namespace, which: str) -> tuple[float, ...
             )
         lo, hi = DEFAULT_RANGES[name]
         start, stop = lo if start is None else start, hi if stop is None else stop
-    if points is None:
-        raise ParameterError(f"--points{suffix} is required with --{which} {name}")
+    _check_points(name, start, stop, points, suffix)
     return linspace(name, start, stop, points)
 
 
@@ -119,19 +145,20 @@ def sweep(args: argparse.Namespace) -> int:
     """`sweep`: a 1-D range or a 2-D grid, resumable; sweep.csv, events.csv, figures."""
     from ..api.sweeps import resume_sweep
     from ..api.sweeps import sweep as sweep_params
-    from ..continuation.runner import default_workers
-    from ..params import make_params
+    from ..continuation.runner import SPEC_FILE, default_workers
 
     workers = default_workers() if args.workers is None else args.workers
     if isinstance(workers, int) and workers < 1:
         raise ParameterError(f"--workers {workers}: must be >= 1")
     progress = not args.quiet
+    if args.resume and not (Path(args.resume) / SPEC_FILE).is_file():
+        raise ParameterError(f"--resume {args.resume!r}: not a sweep folder (no {SPEC_FILE})")
     if args.resume:
         sw = resume_sweep(args.resume, workers, args.scheduler, progress, sys.argv[:])
     else:
         values = _sweep_spec_values(args, "param")
         values2 = _sweep_spec_values(args, "param2")
-        base = make_params(None, overrides(args))
+        base = params_from(args)
         sw = sweep_params(
             base, args.param, values, settings_from(args), param2=args.param2,
             values2=values2, workers=workers, scheduler=args.scheduler,
@@ -192,7 +219,7 @@ def verify(args: argparse.Namespace) -> int:
     output = output_root(args.out) if args.out else None
     res = solve_params(params, settings_from(args), label=label)
     results = verify_routes(params, res.table, seed=args.seed or 1)
-    text = _verify_text(label, res, results)
+    text = _verify_text(f"{label} ({describe(params)})", res, results)
     print(text)
     ok = not any(r.agrees is False for r in results)
     if output is not None:
@@ -223,9 +250,9 @@ def paper(args: argparse.Namespace) -> int:
 
 def params(args: argparse.Namespace) -> int:
     """`params`: the parameter set a command line describes (Table 1 by default), as TOML."""
-    from ..params import PARAM_MEANING, PARAM_UNITS, make_params
+    from ..params import PARAM_MEANING, PARAM_UNITS
 
-    p = make_params(args.case, overrides(args))
+    p = params_from(args)  # exactly the set `solve` would solve
     for name, value in p.as_dict().items():
         print(f"{name} = {value!r}  # {PARAM_UNITS[name]}, {PARAM_MEANING[name]}")
     return EXIT_OK
@@ -245,7 +272,10 @@ def barriers(args: argparse.Namespace) -> int:
     _warn(found.warnings)
     cols = ["saddle_id", "min_a", "min_b", "barrier_a", "barrier_b"]
     pairs = found.pairs[cols]
-    print(f"{label}: {len(found.table)} saddles, {len(pairs)} pairs of minima joined")
+    print(
+        f"{label} ({describe(params)}): {len(found.table)} saddles, "
+        f"{len(pairs)} pairs of minima joined"
+    )
     print(pairs.to_string(index=False) if len(pairs) else "(no saddle joins two minima)")
     print(_files_line(folder))
     return EXIT_INCOMPLETE if found.warnings else EXIT_OK
@@ -265,6 +295,8 @@ def design_map(args: argparse.Namespace) -> int:
     workers = default_workers() if args.workers is None else args.workers
     if workers < 1:
         raise ParameterError(f"--workers {workers}: must be >= 1")
+    if args.points < 2:
+        raise ParameterError(f"--points {args.points}: a map needs at least 2 points a side")
     ranges = {args.param: (args.start, args.stop), args.param2: (args.start2, args.stop2)}
     root = output_root(args.out)
     found = make_map(
@@ -293,9 +325,12 @@ def design(args: argparse.Namespace) -> int:
     out = Path(args.out) if args.out else None
     if out is not None and out.suffix.lower() != ".csv":
         raise ParameterError(f"--out must name a .csv file, got {args.out!r}")
+    for flag in ("gamma1", "gamma2", "L01", "L02"):
+        value = getattr(args, flag)
+        if value is not None and not math.isfinite(value):
+            raise ParameterError(f"--{flag} {value!r}: must be a finite number")
     dsg = design_pose(params, args.gamma1, args.gamma2, L01=args.L01, L02=args.L02)
-    for name, value in dsg.as_dict().items():
-        print(f"{name} = {value}")
+    print(dsg.as_toml())
     if out is not None:
         output_root(out.parent if str(out.parent) else Path("."))
         write_csv(out, pd.DataFrame([dsg.as_dict()]))

@@ -1,4 +1,4 @@
-"""Command line: `cotm-bertini solve|sweep|verify|paper|params` (docs/cli.md)."""
+"""Command line of cotm-bertini (docs/cli.md)."""
 
 from __future__ import annotations
 
@@ -15,6 +15,12 @@ from .options import (
     add_case,
     add_params,
     add_settings,
+)
+
+PURPOSE = (
+    "Every equilibrium of the planar compliant tensegrity mechanism (two triangles, a rigid rod\n"
+    "and two springs; Tanouye & Vikas, DETC2018-85998), solved with Bertini, each one\n"
+    "classified real, physical and stable; sweeps, proofs and design maps of the same."
 )
 
 
@@ -95,7 +101,7 @@ def _verify_parser(sub) -> None:
     add_case(v)
     add_params(v)
     add_settings(v)
-    v.add_argument("--out", metavar="DIR", help="also write verify.csv and verify.json there")
+    v.add_argument("--out", metavar="DIR", help="also write verify.json (the report) there")
     v.set_defaults(run=commands.verify)
 
 
@@ -129,9 +135,12 @@ def _map_parser(sub) -> None:
 
 def _design_parser(sub) -> None:
     d = sub.add_parser(
-        "design", help="the free lengths that hold a chosen pose in equilibrium (inverse design)"
+        "design",
+        help="the free lengths that hold a chosen pose in equilibrium (inverse design)",
+        description="Print the free lengths that hold the pose (gamma1, gamma2) in equilibrium, "
+        "as TOML with units; angles in [0, 360) deg, lengths in m.",
     )
-    add_case(d, default="case3 (its L01, L02 are not used)")
+    add_case(d, default="none (L01, L02 of the parameters are not used)")
     add_params(d)
     d.add_argument("--gamma1", type=float, required=True, metavar="DEG", help="rod angle")
     d.add_argument("--gamma2", type=float, required=True, metavar="DEG", help="top body angle")
@@ -143,9 +152,17 @@ def _design_parser(sub) -> None:
 
 
 def _parser() -> argparse.ArgumentParser:
-    ap = Parser(prog="cotm-bertini", description=__doc__)
+    ap = Parser(
+        prog="cotm-bertini",
+        description=PURPOSE,
+        epilog="`cotm-bertini COMMAND --help` describes a command's options; docs/cli.md "
+        "describes them all, with the exit codes.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     ap.add_argument("--version", action="version", version=_version_text())
-    sub = ap.add_subparsers(dest="command", required=True, parser_class=Parser)
+    sub = ap.add_subparsers(
+        title="commands", dest="command", required=True, parser_class=Parser, metavar="COMMAND"
+    )
     _solve_parser(sub)
     _sweep_parser(sub)
     _verify_parser(sub)
@@ -156,8 +173,10 @@ def _parser() -> argparse.ArgumentParser:
     _barriers_parser(sub)
     _map_parser(sub)
     _design_parser(sub)
-    pr = sub.add_parser("params", help="print the parameters (Table 1 and a case preset)")
-    add_case(pr, default="none: Table 1 as printed (L01 = L02 = 0)")
+    pr = sub.add_parser(
+        "params", help="print the parameter set the other commands would use, as TOML"
+    )
+    add_case(pr)
     add_params(pr)
     pr.set_defaults(run=commands.params)
     return ap

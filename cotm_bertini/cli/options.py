@@ -5,7 +5,16 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..params import CASES, PARAM_NAMES, Params, load_toml, make_params, parse_assignment
+from ..params import (
+    CASES,
+    PARAM_NAMES,
+    PARAM_UNITS,
+    TABLE1,
+    Params,
+    load_toml,
+    make_params,
+    parse_assignment,
+)
 from ..settings import Settings
 
 # Exit codes (docs/cli.md).
@@ -24,10 +33,13 @@ class Parser(argparse.ArgumentParser):
         self.exit(EXIT_USAGE, f"cotm-bertini: error: {message}\n")
 
 
-DEFAULT_CASE = "case3"
+# Without a case the parameters are Table 1 as printed (L01 = L02 = 0), as for cb.Params(): one
+# rule for every command (docs/cli.md).
+NO_CASE = "none: Table 1 as printed, L01 = L02 = 0"
+NO_CASE_LABEL = "table1"
 
 
-def add_case(p: argparse.ArgumentParser, default: str = DEFAULT_CASE) -> None:
+def add_case(p: argparse.ArgumentParser, default: str = NO_CASE) -> None:
     """The positional case preset."""
     p.add_argument(
         "case",
@@ -86,7 +98,7 @@ def overrides(args: argparse.Namespace) -> dict[str, float]:
     """--params FILE.toml, then each --set NAME=VALUE."""
     values: dict[str, float] = {}
     if args.params:
-        values.update(load_toml(args.params))
+        values.update(load_toml(args.params, "--params"))
     for text in args.set:
         name, value = parse_assignment(text)
         values[name] = value
@@ -94,8 +106,21 @@ def overrides(args: argparse.Namespace) -> dict[str, float]:
 
 
 def params_from(args: argparse.Namespace) -> Params:
-    """The parameters a command line asks for: Table 1, the case, the file, the --set's."""
-    return make_params(args.case or DEFAULT_CASE, overrides(args))
+    """The parameters a command line asks for: Table 1, the case, the file, the --set's (every
+    command, `params` included, reads them here)."""
+    return make_params(getattr(args, "case", None), overrides(args))
+
+
+def describe(params: Params) -> str:
+    """The free lengths a command used, and every other value that is not Table 1's."""
+    values = params.as_dict()
+    free = [f"{n} = {values[n]:.12g} {PARAM_UNITS[n]}" for n in ("L01", "L02")]
+    changed = [
+        f"{n} = {v:.12g} {PARAM_UNITS[n]}"
+        for n, v in values.items()
+        if n not in ("L01", "L02") and v != TABLE1[n]
+    ]
+    return ", ".join(free) + (f"; {', '.join(changed)}" if changed else "")
 
 
 def label_of(args: argparse.Namespace) -> str:
@@ -104,7 +129,7 @@ def label_of(args: argparse.Namespace) -> str:
         return args.case
     if args.params:
         return Path(args.params).stem
-    return "custom" if args.set else DEFAULT_CASE
+    return "custom" if args.set else NO_CASE_LABEL
 
 
 def settings_from(args: argparse.Namespace) -> Settings:

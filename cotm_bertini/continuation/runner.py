@@ -110,12 +110,12 @@ def pending_points(spec: SweepSpec, folder: Path) -> list[int]:
 def prepare(spec: SweepSpec, folder: Path) -> Path:
     """The sweep folder for `spec`: created, or an earlier one for the same spec (resumed)."""
     if folder.exists() and not folder.is_dir():
-        raise ParameterError(f"--out {str(folder)!r}: exists and is not a directory")
+        raise ParameterError(f"sweep folder {str(folder)!r}: exists and is not a directory")
     spec_path = folder / SPEC_FILE
     if spec_path.is_file():
         saved = json.loads(spec_path.read_text())
         if saved.get("spec") != spec.to_json():
-            raise ParameterError(f"{folder}: holds a different sweep; use another --out")
+            raise ParameterError(f"{folder}: holds a different sweep; write to another folder")
     else:
         (folder / "points").mkdir(parents=True, exist_ok=True)
         write_json(spec_path, {"spec": spec.to_json(), "key": spec.key()})
@@ -127,7 +127,7 @@ def load_spec(folder: Path) -> SweepSpec:
     """The spec a sweep folder was made for."""
     path = Path(folder) / SPEC_FILE
     if not path.is_file():
-        raise ParameterError(f"--resume {str(folder)!r}: no {SPEC_FILE} there")
+        raise ParameterError(f"folder {str(folder)!r}: no {SPEC_FILE} there (not a sweep folder)")
     return SweepSpec.from_json(json.loads(path.read_text())["spec"])
 
 
@@ -155,8 +155,7 @@ def run_points(
     Pending points are cut into runs of grid neighbours (snake order over a 2-D grid); each run
     is solved in order on one worker, every point continued from the one before.
     """
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-        raise ParameterError(f"--workers {workers!r}: must be an integer >= 1")
+    check_workers(workers)
     todo = pending_points(spec, folder)
     total = spec.size()
     stats = {"points": total, "skipped": total - len(todo), "solved": 0, "lost_paths": 0}
@@ -209,6 +208,12 @@ def assemble(spec: SweepSpec, folder: Path):
         raise RuntimeError(f"{folder}: {len(missing)} points not solved yet (first {missing[0]})")
     frames = [read_table(point_file(folder, i)) for i in range(spec.size())]
     return pd.concat(frames, ignore_index=True)
+
+
+def check_workers(workers: object) -> None:
+    """Refuse a worker count that is not an integer >= 1, naming the argument `workers`."""
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise ParameterError(f"workers = {workers!r}: must be an integer >= 1")
 
 
 def default_workers() -> int:

@@ -49,17 +49,17 @@ class SweepSpec:
     certify: bool = False  # prove every point (docs/certify.md)
 
     def __post_init__(self) -> None:
-        for name, option in ((self.param, "--param"), (self.param2, "--param2")):
+        for name, option in ((self.param, "param"), (self.param2, "param2")):
             if name is not None and name not in PARAM_NAMES:
                 raise ParameterError(
-                    f"{option} {name!r}: unknown parameter (known: {' '.join(PARAM_NAMES)})"
+                    f"{option} = {name!r}: unknown parameter (known: {' '.join(PARAM_NAMES)})"
                 )
         object.__setattr__(self, "values", _values(self.param, "values", self.values))
         if self.param2 is not None:
             if self.param2 == self.param:
-                raise ParameterError(f"--param2 {self.param2!r}: same as --param")
+                raise ParameterError(f"param2 = {self.param2!r}: same as param")
             if self.values2 is None:
-                raise ParameterError(f"--param2 {self.param2!r}: needs its values")
+                raise ParameterError(f"param2 = {self.param2!r}: needs values2")
             object.__setattr__(self, "values2", _values(self.param2, "values2", self.values2))
         elif self.values2 is not None:
             raise ParameterError("values2 given without param2")
@@ -160,13 +160,19 @@ class SweepSpec:
 
 
 def linspace(name: str, start: float, stop: float, points: int) -> tuple[float, ...]:
-    """`points` evenly spaced values; refuses a degenerate request with one line."""
+    """`points` evenly spaced values from `start` to `stop`; one value only when they are equal.
+    A degenerate request is refused with one line naming the arguments."""
     if isinstance(points, bool) or not isinstance(points, int) or points < 1:
-        raise ParameterError(f"--points {points!r} for {name}: must be an integer >= 1")
+        raise ParameterError(f"points = {points!r} for {name}: must be an integer >= 1")
+    if points == 1 and start != stop:
+        raise ParameterError(
+            f"points = 1 for {name} from start = {start:g} to stop = {stop:g}: a range needs at "
+            "least 2 points (for one value, give start == stop)"
+        )
     if points > 1 and start == stop:
         raise ParameterError(
-            f"--from {start:g} --to {stop:g} for {name}: an empty range cannot hold {points} "
-            "distinct points (use --points 1, or widen the range)"
+            f"start = stop = {start:g} for {name}: an empty range cannot hold {points} distinct "
+            "points (points = 1, or widen the range)"
         )
     import numpy as np
 

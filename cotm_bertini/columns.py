@@ -1,5 +1,5 @@
-"""What every column of solutions.csv, sweep.csv, events.csv, barriers.csv and the design CSV
-means (written into each run)."""
+"""What every column of solutions.csv, sweep.csv, events.csv, barriers.csv, folds.csv,
+regions.csv and the design CSV means, and every solve count (written into each run)."""
 
 from __future__ import annotations
 
@@ -92,7 +92,9 @@ FOLDS = {
 }
 
 REGIONS = {
-    "L01, L02": "a grid point (m)",
+    "L01, L02": "a grid point (m): the window's ends and the evenly spaced values between, "
+    "each the double nearest its exact decimal value (0 to 14 in 41 points gives 2.1, not "
+    "2.0999999999999996)",
     "physical": "the number of physical equilibria there (a direct solve)",
     "stable": "the number of stable equilibria there",
 }
@@ -130,18 +132,43 @@ BARRIERS = {
 }
 
 
-def markdown(title: str, columns: dict[str, str]) -> str:
-    """A Markdown table of columns and their meanings."""
-    lines = [f"## {title}", "", "| column | meaning |", "|---|---|"]
+COUNTS = {
+    "paths_tracked": "paths the solver tracked (homotopy: the generic set's nonsingular "
+    "solutions; cli: the total degree)",
+    "finite_endpoints": "tracked paths that ended at a finite point",
+    "closed_form_endpoints": "endpoints computed in closed form instead of tracked: the double "
+    "roots where one spring with L0 > 0 has zero length (d = 0), one endpoint each",
+    "infinite_or_failed_paths": "tracked paths that went to infinity or failed",
+    "lost_paths": "failed paths that may have hidden a solution (the status is then incomplete)",
+    "distinct_solutions": "rows of solutions.csv: every distinct finite solution, real or not "
+    "(= real + complex)",
+    "real": "real rows, physical or not (= physical + negative_d + zero_length_real)",
+    "complex": "non-real rows (zero_length_complex of them have a spring of zero length)",
+    "physical": "physical rows: the equilibria of the mechanism",
+    "stable": "stable rows: strict local minima of V (a subset of physical)",
+    "negative_d": "real rows with a spring length d < 0 (reason negative_d; always real)",
+    "zero_length_real": "real rows where a spring with L0 > 0 has zero length (reason "
+    "zero_length_spring and real): the cone points of V, not equilibria",
+    "zero_length_complex": "non-real rows where a spring with L0 > 0 has zero length (reason "
+    "zero_length_spring, not real; also the points where both springs do)",
+    "singular": "rows flagged singular, whatever their reason (the closed-form d = 0 roots among "
+    "them)",
+}
+
+
+def markdown(title: str, columns: dict[str, str], head: str = "column") -> str:
+    """A Markdown table of columns (or other names) and their meanings."""
+    lines = [f"## {title}", "", f"| {head} | meaning |", "|---|---|"]
     lines += [f"| `{name}` | {text} |" for name, text in columns.items()]
     return "\n".join(lines) + "\n"
 
 
 def reference(*tables: str, title: str = "Columns of the CSV files in this folder") -> str:
-    """The column reference of a run folder: 'solutions', 'sweep', 'events', 'barriers',
-    'folds', 'regions', 'design'."""
+    """The column reference of a run folder: 'solutions', 'counts', 'sweep', 'events',
+    'barriers', 'folds', 'regions', 'design'."""
     known = {
         "solutions": ("solutions.csv", SOLUTIONS),
+        "counts": ("counts (run.json `counts`, `res.counts`)", COUNTS, "count"),
         "sweep": ("sweep.csv", SWEEP),
         "events": ("events.csv", EVENTS),
         "barriers": ("barriers.csv", BARRIERS),
@@ -158,10 +185,12 @@ def document() -> str:
     """docs/columns.md: every table's columns."""
     return reference(
         "solutions",
+        "counts",
         "sweep",
         "events",
         "barriers",
         "folds",
+        "regions",
         "design",
         title="Columns of the CSV files",
     )

@@ -21,6 +21,37 @@ def cache_root() -> Path:
     return Path(root)
 
 
+def umask() -> int:
+    """The process's file-creation mask, read without changing it where Linux allows."""
+    try:
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("Umask:"):
+                return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    mask = os.umask(0o022)  # elsewhere: set and restore at once
+    os.umask(mask)
+    return mask
+
+
+def file_mode() -> int:
+    """The mode an ordinary new file gets: 0666 less the umask (tempfile's files are 0600)."""
+    return 0o666 & ~umask()
+
+
+def folder_mode() -> int:
+    """The mode an ordinary new folder gets: 0777 less the umask (tempfile's are 0700)."""
+    return 0o777 & ~umask()
+
+
+def temp_folder(prefix: str, parent: Path | None = None) -> Path:
+    """A new empty folder with a unique name (tempfile.mkdtemp), with the umask's mode: its
+    files may end up in a run folder, which must be as shareable as any other folder."""
+    folder = Path(tempfile.mkdtemp(prefix=prefix, dir=parent))
+    folder.chmod(folder_mode())
+    return folder
+
+
 def atomic_write_text(path: Path, text: str) -> None:
     """Write text to path via a temporary file in the same folder and an atomic rename."""
     atomic_write_bytes(path, text.encode())
@@ -32,6 +63,7 @@ def atomic_write_bytes(path: Path, data: bytes) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
+        os.fchmod(fd, file_mode())  # as an ordinary file: mkstemp's 0600 hides it from a group
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
             fh.flush()
@@ -115,6 +147,19 @@ def new_folder(dest: str | Path) -> Iterator[Path]:
     work.mkdir(parents=True)
     yield work
     work.rename(dest)
+
+
+def link_tree(source: Path, dest: Path) -> None:
+    """Put a copy of the folder `source` at `dest` (which must not exist): each file hard-linked
+    (no space used; the files stay if `source` is deleted), copied where linking fails."""
+
+    def link(src: str, dst: str) -> None:
+        try:
+            os.link(src, dst)
+        except OSError:  # another file system, or links not allowed
+            shutil.copy2(src, dst)
+
+    shutil.copytree(source, dest, copy_function=link, ignore=shutil.ignore_patterns(".*"))
 
 
 def link_latest(root: Path, final: Path) -> None:

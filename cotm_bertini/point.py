@@ -71,9 +71,13 @@ class PointSolution:
 def path_counts(
     endpoints: Endpoints, table: dict, paths_tracked: int | None, lost: int | None
 ) -> dict:
-    """Path and solution counts; closed-form endpoints are counted apart from tracked ones."""
+    """Path and solution counts, each meaning one thing (docs/columns.md, "counts"): closed-form
+    endpoints apart from tracked ones; real = physical + negative_d + zero_length_real, and
+    distinct_solutions = real + complex, complex counting zero_length_complex among its rows."""
     tracked_ends = endpoints.tracked
     other = None if paths_tracked is None else paths_tracked - tracked_ends
+    real = np.asarray(table["is_real"], dtype=bool)
+    zero = np.asarray(table["reason"] == "zero_length_spring", dtype=bool)
     return {
         "paths_tracked": paths_tracked,
         "finite_endpoints": tracked_ends,
@@ -81,11 +85,13 @@ def path_counts(
         "infinite_or_failed_paths": other,
         "lost_paths": lost,
         "distinct_solutions": len(table["solution_id"]),
-        "real": int(table["is_real"].sum()),
+        "real": int(real.sum()),
+        "complex": int((~real).sum()),
         "physical": int(table["physical"].sum()),
         "stable": int(table["stable"].sum()),
-        "zero_length_artefacts": int((table["reason"] == "zero_length_spring").sum()),
         "negative_d": int((table["reason"] == "negative_d").sum()),
+        "zero_length_real": int((zero & real).sum()),
+        "zero_length_complex": int((zero & ~real).sum()),
         "singular": int(table["singular"].sum()),
     }
 

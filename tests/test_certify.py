@@ -55,15 +55,15 @@ def test_random_geometries_are_proved(seed):
 
 def _tampered(table, drop: bool):
     """The case-2 table with its first physical row dropped, or moved 0.5 deg."""
-    rows = np.flatnonzero(table["physical"].to_numpy())
+    first = table.index[np.flatnonzero(table["physical"].to_numpy())[0]]  # its label
     if drop:
-        return table.drop(index=rows[0]).reset_index(drop=True)
+        return table.drop(index=first).reset_index(drop=True)
     moved = table.copy()
-    g = np.radians(moved.loc[rows[0], ["gamma1_deg", "gamma2_deg"]].to_numpy(float) + 0.5)
-    moved.loc[rows[0], ["gamma1_deg", "gamma2_deg"]] = np.degrees(g)
+    g = np.radians(moved.loc[first, ["gamma1_deg", "gamma2_deg"]].to_numpy(float) + 0.5)
+    moved.loc[first, ["gamma1_deg", "gamma2_deg"]] = np.degrees(g)
     for name, value in (("c1", np.cos(g[0])), ("s1", np.sin(g[0])), ("c2", np.cos(g[1])),
                         ("s2", np.sin(g[1]))):  # fmt: skip
-        moved.loc[rows[0], f"{name}_re"] = value
+        moved.loc[first, f"{name}_re"] = value
     return moved
 
 

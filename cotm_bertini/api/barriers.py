@@ -21,7 +21,8 @@ BARRIERS_CSV = "barriers.csv"
 @dataclass(frozen=True)
 class Barriers:
     """Every saddle's two descents and barriers (`table`, see docs/columns.md), `pairs` (the
-    lowest saddle of each pair of minima: their barrier), and the paths (deg) by saddle_id."""
+    lowest saddle of each pair of minima: their barrier), and the paths (deg) by saddle_id.
+    Both tables are indexed by saddle_id, as the solutions table is by solution_id."""
 
     params: Params
     solutions: pd.DataFrame
@@ -32,7 +33,7 @@ class Barriers:
     @property
     def pairs(self) -> pd.DataFrame:
         """One row per pair of distinct minima joined by a saddle: the lowest such saddle."""
-        return self.table[self.table.lowest].reset_index(drop=True)
+        return self.table[self.table.lowest]
 
     @property
     def warnings(self) -> list[str]:
@@ -73,4 +74,5 @@ def barriers(res: Solutions) -> Barriers:
 
     t0 = time.perf_counter()
     table, paths = saddle_connections(res.params, res.table)
+    table = table.set_axis(pd.Index(table["saddle_id"].to_numpy(dtype=int)), axis=0)
     return Barriers(res.params, res.table, table, paths, time.perf_counter() - t0)

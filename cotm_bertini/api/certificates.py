@@ -17,7 +17,7 @@ def certify(res: Solutions, strict: bool = True):
     """
     from ..analysis.certify import certify_table
 
-    cert = certify_table(res.params, res.table)
+    cert = certify_table(res.params, res.table.reset_index(drop=True))  # rows by position
     res.attach_certificate(cert)
     if strict and cert.status == "contradiction":
         raise CertificateError("; ".join(cert.contradictions), cert)

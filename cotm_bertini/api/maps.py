@@ -13,16 +13,18 @@ import pandas as pd
 
 from ..columns import reference
 from ..errors import ParameterError
-from ..fs import atomic_write_text, new_folder, write_csv, write_json
+from ..fs import atomic_write_text, link_tree, new_folder, write_csv, write_json
 from ..params import Params
 from ..settings import Settings
 
 FREE_LENGTHS = ("L01", "L02")
+SWEEP_FOLDER = "sweep"  # in a saved map: the 2-D sweep behind regions.csv
 
 
 @dataclass(frozen=True)
 class DesignMap:
-    """Fold points inside the window (`folds`), the grid of counts (`regions`), timings."""
+    """Fold points inside the window (`folds`), the grid of counts (`regions`), timings; the
+    2-D sweep that counted them is in `record["sweep_folder"]`."""
 
     params: Params
     folds: pd.DataFrame
@@ -36,15 +38,19 @@ class DesignMap:
         return plot_map(self.params, self.regions, self.folds, path)
 
     def save(self, folder: str | Path, plots: bool = True) -> Path:
-        """folds.csv, regions.csv, columns.md, run.json [, map.png/svg] in a new folder, built
+        """folds.csv, regions.csv, columns.md, run.json [, map.png/svg] and sweep/ (the 2-D
+        sweep behind regions.csv, hard-linked from where it was solved) in a new folder, built
         under a hidden name and renamed when complete."""
+        source = Path(self.record["sweep_folder"])
         with new_folder(folder) as work:
             write_csv(work / "folds.csv", self.folds)
             write_csv(work / "regions.csv", self.regions)
             atomic_write_text(work / "columns.md", reference("folds", "regions"))
             if plots:
                 self.plot(work / "map")
-            write_json(work / "run.json", self.record)
+            link_tree(source, work / SWEEP_FOLDER)
+            record = {**self.record, "sweep_folder": SWEEP_FOLDER, "sweep_solved_in": str(source)}
+            write_json(work / "run.json", record)
         return Path(folder)
 
 
@@ -79,7 +85,7 @@ def design_map(
     t_folds = time.perf_counter() - t0
     inside = folds.physical & folds.L01.between(*l01) & folds.L02.between(*l02)
     folds = folds[inside].reset_index(drop=True)
-    xs, ys = np.linspace(*l01, points), np.linspace(*l02, points)
+    xs, ys = grid_values(*l01, points), grid_values(*l02, points)
     sw = sweep(params, "L01", xs, settings, param2="L02", values2=ys, workers=workers,
                progress=progress)  # fmt: skip
     regions = _counts(sw.table, xs, ys)
@@ -92,6 +98,16 @@ def design_map(
         "sweep_folder": str(sw.folder), "sweep_status": sw.status, "command": sys.argv[:],
     }  # fmt: skip
     return DesignMap(params, folds, regions, record)
+
+
+def grid_values(lo: float, hi: float, points: int) -> np.ndarray:
+    """`points` evenly spaced values from lo to hi, each the double nearest the exact decimal
+    value (computed in decimal arithmetic): 0 to 14 in 41 points gives 2.1, never the
+    2.0999999999999996 of np.linspace."""
+    from decimal import Decimal
+
+    a, b = Decimal(repr(float(lo))), Decimal(repr(float(hi)))
+    return np.array([float(a + (b - a) * k / (points - 1)) for k in range(points)])
 
 
 def _counts(table: pd.DataFrame, xs: np.ndarray, ys: np.ndarray) -> pd.DataFrame:

@@ -3,14 +3,13 @@
 from __future__ import annotations
 
 import shutil
-import tempfile
 import time
 import weakref
 from dataclasses import asdict, fields
 from pathlib import Path
 
 from ..errors import CotmError, ParameterError
-from ..fs import timestamp, write_csv, write_json
+from ..fs import temp_folder, timestamp, write_csv, write_json
 from ..io import cache
 from ..io.runfolder import (
     RUN_JSON,
@@ -21,6 +20,7 @@ from ..io.runfolder import (
     read_solutions,
     solve_record,
     start_copy,
+    summary_head,
     write_solution_files,
 )
 from ..params import Params
@@ -30,8 +30,9 @@ from ..settings import Settings, Tolerances
 class Solutions:
     """The classified solutions of one parameter set, as a table and counts, savable as a run.
 
-    `table` has exactly the solutions.csv columns (docs/columns.md); `physical`, `stable`,
-    `real` and `nonsingular` are its filtered views. `counts`, `morse`, `status` and `warnings`
+    `table` has exactly the solutions.csv columns (docs/columns.md), and its index is the
+    solution_id, so `res.stable.loc[7]` is solution 7; `physical`, `stable`, `real` and
+    `nonsingular` are its filtered views. `counts`, `morse`, `status` and `warnings`
     say what was found and whether a completeness check failed. `save(folder)` writes the run
     folder the command line writes.
     """
@@ -56,14 +57,15 @@ class Solutions:
 
     @property
     def table(self):
-        """Every distinct finite solution (pandas DataFrame, the solutions.csv columns)."""
+        """Every distinct finite solution (pandas DataFrame, the solutions.csv columns), indexed
+        by solution_id."""
         if self._table is None:
             if self._columns is not None:
                 import pandas as pd
 
-                self._table = pd.DataFrame(self._columns)
+                self._table = by_solution_id(pd.DataFrame(self._columns))
             else:
-                self._table = read_solutions(self.folder)
+                self._table = by_solution_id(read_solutions(self.folder))
         return self._table
 
     def attach_certificate(self, cert) -> None:
@@ -115,8 +117,13 @@ class Solutions:
 
     @property
     def summary(self) -> str:
-        """The console report: counts and the real solutions."""
-        return self.record["summary"]
+        """The console report: counts and the real solutions; for an answer from the cache,
+        the solve's time is labelled as that of the cached solve."""
+        text = self.record["summary"]
+        if not self.cache_hit:
+            return text
+        rest = text.split("\n", 1)[1:]
+        return "\n".join([summary_head(self.record, cached=True), *rest])
 
     @property
     def cache_hit(self) -> bool:
@@ -135,6 +142,10 @@ class Solutions:
         record = read_record(work)
         record.update(created=timestamp(), command=command, cache=self.record.get("cache"))
         timings = dict(record.get("timings", {}))
+        if self.cache_hit:  # this run's own costs; the cached solve's are kept, labelled so
+            record["cache"] = {**record["cache"], "solve_timings": timings}
+            record["summary"] = self.summary
+            timings = {"cache_lookup": self.record["cache"]["seconds"]}
         if plots and not figure_files(work):
             t0 = time.perf_counter()
             from ..plot.run import plot_run  # matplotlib only when pictures are asked for
@@ -172,6 +183,7 @@ def solve(
     """
     from ..io import cache as solve_cache
 
+    start = time.perf_counter()
     settings = (settings or Settings()).replace(**options)
     tol = _tolerances(tolerances)
     key = solve_cache.request_key(params.as_dict(), settings.result_key(), tol)
@@ -179,10 +191,10 @@ def solve(
         hit = solve_cache.lookup(key)
         if hit is not None:
             record = read_record(hit)
-            record["cache"] = {"hit": True, "key": key, "solved": record.get("solved")}
+            record["cache"] = {"hit": True, "key": key, "solved": record.get("solved"),
+                               "seconds": time.perf_counter() - start}  # fmt: skip
             return Solutions(params, settings, record, hit)
-    start = time.perf_counter()
-    work = solve_cache.staging_folder() if cache else Path(tempfile.mkdtemp(prefix="cotm-"))
+    work = solve_cache.staging_folder() if cache else temp_folder("cotm-")
     point = _solve_in(work, params, settings, tol, label or "custom")
     record = solve_record(point, tol, label or "custom", key if cache else None)
     record["cache"] = {"hit": False, "key": key if cache else None}
@@ -207,7 +219,7 @@ def _solve_in(work: Path, params: Params, settings: Settings, tol: dict, label: 
     try:
         return solve_point(params, settings, Tolerances(**tol), folder=work, title=label)
     except (CotmError, KeyboardInterrupt) as exc:
-        failed = Path(tempfile.mkdtemp(prefix="cotm-failed-"))
+        failed = temp_folder("cotm-failed-")
         shutil.copytree(work, failed, dirs_exist_ok=True)
         shutil.rmtree(work, ignore_errors=True)
         _failure_record(failed, params, settings, label, exc, time.perf_counter() - start)
@@ -232,6 +244,14 @@ def _failure_record(folder, params, settings, label, exc, seconds) -> None:
             "timings": {"total": seconds},
         },
     )
+
+
+def by_solution_id(frame):
+    """A solutions table indexed by its solution_id column (the column stays), so labels shown
+    and `.loc` agree with the ids that other tables and messages use."""
+    import pandas as pd
+
+    return frame.set_axis(pd.Index(frame["solution_id"].to_numpy(dtype=int)), axis=0)
 
 
 def _tolerances(tolerances: Tolerances | dict | None) -> dict:

@@ -14,8 +14,10 @@ from __future__ import annotations
 
 import hashlib
 import json
+import sys
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -33,6 +35,8 @@ _SUCCESS = "Success"
 DOUBLE_FINAL_TOLERANCE = 1e-8
 DOUBLE_MAX_STEPS = 2000
 SECOND_START = 7919  # seed offset of the independent second generic set
+SECONDS_PER_PATH = 0.06  # an ab-initio path of the generic solve (case 3: 192 paths, ~12 s)
+ANNOUNCE_SECONDS = 2.0  # a generic solve expected to take longer is announced on stderr
 
 
 def _bertini():
@@ -152,10 +156,26 @@ def _load_or_solve(ps: ParametricSystem, seed: int, use_cache: bool) -> GenericS
             return GenericSet.from_json(json.loads(path.read_text()))
         except (ValueError, KeyError):
             path.unlink(missing_ok=True)  # a damaged cache entry is recomputed, not trusted
+    _announce(ps, seed, path if use_cache else None)
     gs = _solve_generic(ps, seed, key)
     if use_cache:
         atomic_write_text(path, json.dumps(gs.to_json()))
     return gs
+
+
+def _announce(ps: ParametricSystem, seed: int, stored: Path | None) -> None:
+    """One line on stderr before a generic solve long enough to be noticed: what, how long."""
+    paths = ps.instantiate([1.0 + 0.1j * k for k in range(len(ps.parameters))]).total_degree
+    seconds = paths * SECONDS_PER_PATH
+    if seconds < ANNOUNCE_SECONDS:
+        return
+    where = f"once: kept in {stored} for every later solve" if stored else "not cached"
+    print(
+        f"cotm-bertini: solving the generic solution set of these equations for seed {seed} "
+        f"({paths} paths, roughly {seconds:.0f} s; {where})",
+        file=sys.stderr,
+        flush=True,
+    )
 
 
 def _solve_generic(ps: ParametricSystem, seed: int, key: str) -> GenericSet:
@@ -171,7 +191,7 @@ def _solve_generic(ps: ParametricSystem, seed: int, key: str) -> GenericSet:
     bertini.random.set_random_seed(seed)
     t0 = time.perf_counter()
     solver = na.ZeroDimSolver(bertini.parse.system(render_system(system)))
-    solver.solve(show_progress=False)
+    solver.solve(show_progress=True)  # a bar on a terminal after 5 s; silent otherwise
     seconds = time.perf_counter() - t0
     meta, pts = solver.solution_metadata(), solver.all_solutions()
     finite = [i for i, m in enumerate(meta) if m.is_finite and _code(m) == _SUCCESS]

@@ -58,10 +58,11 @@ def solve(args: argparse.Namespace) -> int:
     head = f"{label} ({describe(params)}): {res.summary}"
     print(folder if args.quiet else f"{head}\n{_files_line(folder)}")
     if res.cache_hit:
+        hit = res.record["cache"]
         print(
-            f"cache: answered from a solve of {res.record['cache']['solved']} (key "
-            f"{res.record['cache']['key']}) in {(time.perf_counter() - start) * 1e3:.0f} ms; "
-            "--no-cache solves again",
+            f"cache: answered from a solve of {hit['solved']} (key {hit['key']}) in "
+            f"{hit['seconds'] * 1e3:.0f} ms; this command took "
+            f"{time.perf_counter() - start:.2f} s in all; --no-cache solves again",
             file=sys.stderr,
         )
     if cert is not None:
@@ -283,7 +284,7 @@ def barriers(args: argparse.Namespace) -> int:
 
 def design_map(args: argparse.Namespace) -> int:
     """`map`: fold curves and stable-count regions over the (L01, L02) plane."""
-    from ..api.maps import FREE_LENGTHS
+    from ..api.maps import FREE_LENGTHS, SWEEP_FOLDER
     from ..api.maps import design_map as make_map
     from ..continuation.runner import default_workers
 
@@ -309,8 +310,13 @@ def design_map(args: argparse.Namespace) -> int:
     spread = ", ".join(f"{n} stable: {c} points" for n, c in counts.items())
     cusps = int((found.folds.kind == "cusp").sum())
     pieces = found.record["fold_curves"]
-    print(f"map: {len(found.folds)} fold points on {pieces} pieces, {cusps} cusps; {spread}")
+    (lo1, hi1), (lo2, hi2) = found.record["window"]["L01"], found.record["window"]["L02"]
+    print(
+        f"map: in the window L01 {lo1:g}..{hi1:g} m, L02 {lo2:g}..{hi2:g} m: "
+        f"{len(found.folds)} fold points on {pieces} pieces, {cusps} cusps; {spread}"
+    )
     print(_files_line(folder))
+    print(f"the 2-D sweep behind regions.csv: {folder / SWEEP_FOLDER} (sweep.csv, points/)")
     return EXIT_OK if found.record["sweep_status"] == "ok" else EXIT_INCOMPLETE
 
 

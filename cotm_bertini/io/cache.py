@@ -13,11 +13,10 @@ import hashlib
 import json
 import os
 import shutil
-import tempfile
 from functools import cache
 from pathlib import Path
 
-from ..fs import cache_root
+from ..fs import cache_root, temp_folder
 from ..resources import template_texts
 from ..versions import bertini2_version
 
@@ -83,7 +82,7 @@ def staging_folder() -> Path:
     """A new empty folder on the cache's file system, to solve in and then `commit`."""
     root = solves_root()
     root.mkdir(parents=True, exist_ok=True)
-    return Path(tempfile.mkdtemp(dir=root, prefix=".tmp-"))
+    return temp_folder(".tmp-", root)
 
 
 def commit(key: str, folder: Path) -> Path:

@@ -58,18 +58,26 @@ def solve_record(point: PointSolution, tolerances: dict, label: str, key: str | 
     return record
 
 
-def summary_text(record: dict, table: dict) -> str:
-    """The console report of a solve: counts, the real solutions (the caller adds a label)."""
+def summary_head(record: dict, cached: bool = False) -> str:
+    """The first line of a solve's report: counts, engine and the solve's time, which for an
+    answer from the cache is labelled as the time of that earlier solve."""
     c, engine = record["counts"], record["engine"]
     closed = c["closed_form_endpoints"]
-    lines = [
+    seconds = f"{record['timings'].get('solve', 0.0):.2f} s"
+    if cached:
+        seconds = f"(cached: {seconds} when solved on {record.get('solved', '?')})"
+    return (
         f"{c['distinct_solutions']} distinct finite solutions "
         f"({c['real']} real, {c['physical']} physical, {c['stable']} stable) from "
         f"{c['finite_endpoints']} finite endpoints of {c['paths_tracked']} paths tracked"
         + (f" and {closed} computed in closed form" if closed else "")
-        + f"; {engine['flavour']} ({engine['path']} {engine['version']}) "
-        f"{record['timings'].get('solve', 0.0):.2f} s"
-    ]
+        + f"; {engine['flavour']} ({engine['path']} {engine['version']}) {seconds}"
+    )
+
+
+def summary_text(record: dict, table: dict) -> str:
+    """The console report of a solve: counts, the real solutions (the caller adds a label)."""
+    lines = [summary_head(record)]
     real = [k for k, r in enumerate(table["is_real"]) if r]
     if real:
         lines.append(_real_rows_text(table, real))
@@ -98,7 +106,7 @@ def _real_rows_text(table: dict, rows: list[int]) -> str:
 def write_solution_files(folder: Path, point: PointSolution) -> None:
     """solutions.csv, columns.md and the input file (unless the solver wrote it)."""
     atomic_write_text(folder / SOLUTIONS_CSV, columns_csv(point.columns))
-    atomic_write_text(folder / COLUMNS_MD, reference("solutions"))
+    atomic_write_text(folder / COLUMNS_MD, reference("solutions", "counts"))
     if not (folder / "input").exists():
         atomic_write_text(folder / "input", point.input_text)
 

@@ -15,6 +15,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
+from ..fs import file_mode
 from ..params import PARAM_UNITS, Params
 
 FORMATS = ("png", "svg")
@@ -32,6 +33,7 @@ def save(fig: Figure, path: str | Path, dpi: int = 110) -> list[Path]:
         targets = [path.with_name(f"{path.name}.{fmt}") for fmt in FORMATS]
     for target in targets:
         fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
+        os.fchmod(fd, file_mode())  # as an ordinary file (mkstemp's are 0600)
         os.close(fd)
         try:
             # Reproducible SVG: fixed id salt, no date stamp.

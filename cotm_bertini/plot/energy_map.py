@@ -18,6 +18,14 @@ KIND_STYLE = {  # marker, face colour, size, label
     "max": ("s", "red", 60, "max of V"),
     "degenerate": ("D", "magenta", 50, "degenerate critical point"),
 }
+MARKER_WORDS = {"o": "circle", "^": "triangle", "s": "square", "D": "diamond"}
+PATH_COLOUR = "white"  # the descent paths on the barrier map
+
+
+def marker_words(kind: str) -> str:
+    """How a title names the marker of a kind of equilibrium: 'orange triangles'."""
+    marker, colour = KIND_STYLE[kind][:2]
+    return f"{colour.removeprefix('dark').removeprefix('lime')} {MARKER_WORDS[marker]}s"
 
 
 def energy_grid(params: Params, n: int = 300) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -128,14 +136,21 @@ def barrier_figure(params: Params, solutions: pd.DataFrame, paths: dict, n: int 
     modulo 360 deg with a break where a path wraps."""
     fig = energy_map_figure(params, solutions, n)
     ax = fig.axes[0]
+    label = "descent path from a saddle"
     for saddle, halves in paths.items():
         for path in halves:
             wrapped = np.mod(path, 360.0)
             jumps = np.abs(np.diff(wrapped, axis=0)).max(axis=1) > 180.0
             xy = np.insert(wrapped, np.flatnonzero(jumps) + 1, np.nan, axis=0)
-            ax.plot(*xy.T, color="white", lw=1.4, gid=f"descent-{saddle}")
+            ax.plot(*xy.T, color=PATH_COLOUR, lw=1.4, gid=f"descent-{saddle}", label=label)
+            label = "_nolegend_"  # one legend entry for all the paths
     ax.set_title(
-        "Gradient descent from each saddle (white) on V(gamma1, gamma2)\n" + describe(params),
+        f"Descent paths ({PATH_COLOUR} lines) from each saddle ({marker_words('saddle')}) down "
+        f"V(gamma1, gamma2) to the minima ({marker_words('min')})\n" + describe(params),
         fontsize=10,
     )
+    for legend in list(fig.legends):  # redrawn with the paths in it
+        legend.remove()
+    if ax.get_legend_handles_labels()[0]:
+        fig.legend(loc="outside lower center", ncols=3, fontsize=8, frameon=True)
     return fig

@@ -18,6 +18,7 @@ import numpy as np
 from .analysis.classify import classify_columns
 from .analysis.morse import morse_check
 from .backends.endpoints import Endpoints
+from .errors import ParameterError
 from .model.compiled import parametric_system
 from .params import Params
 from .settings import Settings, Tolerances
@@ -189,3 +190,83 @@ def _cli(params: Params, settings: Settings, system, folder: Path, title: str, t
     # Bertini 1 lists failed paths; those truncated on their way to infinity are not lost.
     lost = None if out.failed_paths is None else out.failed_paths - (out.truncated_infinite or 0)
     return cs.endpoints, cs.paths_tracked, lost, engine, details, cs.input_text, None
+
+
+def solve_framework_point(
+    fw, settings: Settings = Settings(), tolerances: Tolerances = Tolerances()
+) -> PointSolution:
+    """Every equilibrium of a framework (cb.Framework): each taut set of its cables solved by
+    the parameter homotopy, classified, checked for completeness, in one table."""
+    from .analysis.framework_checks import completeness, framework_counts, order_rows
+    from .model.framework.units import normalized_slots, units
+
+    if settings.engine != "homotopy":
+        raise ParameterError(
+            f"engine = {settings.engine!r}: a framework is solved by the in-process homotopy "
+            "engine (engine='homotopy')"
+        )
+    t = Timings()
+    unit = units(fw)
+    target, centre = normalized_slots(fw), normalized_slots(fw.at_defaults())
+    parts, report, texts = [], {}, []
+    for taut in taut_sets(fw):
+        part, info, text = _solve_taut_set(fw, taut, unit, target, centre, settings, tolerances, t)
+        report[" ".join(taut) or "none"] = info
+        if part is not None:
+            parts.append(part)
+            texts.append(text)
+    with t.stage("classify"):
+        table = order_rows(fw, parts)
+        checks = completeness(fw, table, report)
+    counts = framework_counts(table, report)
+    status = STATUS_INCOMPLETE if checks["warnings"] else STATUS_OK
+    engine = {"flavour": "homotopy", "path": "bertini module (in-process)",
+              "version": _bertini_version()}  # fmt: skip
+    shape = {"taut_sets": list(report), "units": {"length": unit[0], "stiffness": unit[1]}}
+    return PointSolution(
+        fw, settings, table, None, counts, checks["morse"], status, tuple(checks["warnings"]),
+        engine, shape, {"taut_sets": report}, "\n".join(texts), t.stages,
+    )  # fmt: skip
+
+
+def taut_sets(fw) -> list[tuple[str, ...]]:
+    """The subsets of the cables that can be taut together (all taut first), each its own
+    polynomial system: a cable longer than its free length in every pose is in all of them, one
+    never longer in none (model.framework.reach bounds the lengths over every pose)."""
+    from itertools import combinations
+
+    from .model.framework.reach import cable_states
+
+    states = cable_states(fw)
+    always = tuple(n for n, s in states.items() if s == "taut")
+    either = [n for n, s in states.items() if s == "either"]
+    subsets = [c for r in range(len(either), -1, -1) for c in combinations(either, r)]
+    order = [c.name for c in fw.cables]
+    return [tuple(sorted(always + c, key=order.index)) for c in subsets]
+
+
+def _solve_taut_set(fw, taut, unit, target, centre, settings, tolerances, t: Timings):
+    """One taut set: (its rows or None, what was done, the homotopy input text)."""
+    from .analysis.framework_checks import continuum_check
+    from .analysis.framework_classify import framework_columns
+    from .backends.target import solve_parameters
+    from .model.framework.compiled import framework_system, variable_groups
+
+    with t.stage("derive"):
+        fs = framework_system(fw, taut)
+    if fs.free:
+        # With these cables slack something moves freely: equilibria there form a continuum,
+        # which matters only where every cable of the set can be slack at once.
+        return None, continuum_check(fw, fs, unit), ""
+    with t.stage("solve"):
+        hs = solve_parameters(fs.ps, target, centre, settings, variable_groups(fs))
+    with t.stage("classify"):
+        part = framework_columns(fw, fs, hs.endpoints, unit, tolerances)
+    info = {**hs.info, "variables": list(fs.ps.variables), "functions": len(fs.ps.names)}
+    return part, info, hs.input_text
+
+
+def _bertini_version() -> str:
+    from .versions import bertini2_version
+
+    return bertini2_version()

@@ -61,7 +61,7 @@ def wrap_degrees(angle: np.ndarray, digits: int | None = None) -> np.ndarray:
 
 
 @dataclass(frozen=True)
-class _Merged:
+class Merged:
     """The distinct solutions of a set of endpoints (normalised units)."""
 
     x: np.ndarray  # refined point of each solution
@@ -73,12 +73,25 @@ class _Merged:
     accuracy: np.ndarray
 
 
-def _merge(params: Params, system: PolySystem, endpoints: Endpoints, tol: Tolerances) -> _Merged:
+def _merge(params: Params, system: PolySystem, endpoints: Endpoints, tol: Tolerances) -> Merged:
     """Snap, Newton-refine and cluster the endpoints into distinct solutions."""
     is_d = np.array([v.startswith("d") for v in endpoints.variables])
     x0 = np.where(is_d, endpoints.points / params.L3, endpoints.points)
-    acc = np.nan_to_num(endpoints.accuracy_estimate, nan=0.0)
     x0, snapped = snap_zero_length(params, endpoints.variables, x0, tol.snap)
+    return merge_endpoints(system, x0, endpoints, tol, snapped)
+
+
+def merge_endpoints(
+    system: PolySystem,
+    x0: np.ndarray,
+    endpoints: Endpoints,
+    tol: Tolerances,
+    snapped: np.ndarray | None = None,
+) -> Merged:
+    """Newton-refine endpoints `x0` (normalised units) and cluster them into distinct solutions;
+    `snapped` marks points put exactly on a known singular root (not refined, singular)."""
+    snapped = np.zeros(len(x0), dtype=bool) if snapped is None else snapped
+    acc = np.nan_to_num(endpoints.accuracy_estimate, nan=0.0)
     # The snapped points are exact (and exactly singular): Newton has nothing to do there.
     x, res = x0.copy(), np.zeros(len(x0))
     if (~snapped).any():
@@ -91,7 +104,7 @@ def _merge(params: Params, system: PolySystem, endpoints: Endpoints, tol: Tolera
     labels = cluster_endpoints(x, singular, acc, tol.merge)
     groups = [np.flatnonzero(labels == g) for g in range(labels.max() + 1 if len(labels) else 0)]
     best = np.array([m[np.argmin(res[m])] for m in groups], dtype=int)
-    return _Merged(
+    return Merged(
         x=x[best] if len(best) else np.zeros((0, len(endpoints.variables)), complex),
         multiplicity=np.array([len(m) for m in groups], dtype=int),
         paths=[" ".join(str(int(p)) for p in endpoints.path_number[m]) for m in groups],

@@ -16,6 +16,7 @@ import hashlib
 import json
 import sys
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -125,9 +126,16 @@ START_CENTRE = {
 START_SPREAD = 0.5
 
 
-def generic_key(ps: ParametricSystem, seed: int) -> str:
+def generic_key(
+    ps: ParametricSystem,
+    seed: int,
+    centre: dict[str, float] | None = None,
+    groups: list[list[str]] | None = None,
+) -> str:
     """Content hash of what a generic set depends on: equations, seed, start, engine version."""
-    start = {"centre": START_CENTRE, "spread": START_SPREAD}
+    start = {"centre": START_CENTRE if centre is None else centre, "spread": START_SPREAD}
+    if groups is not None:
+        start["groups"] = groups
     blob = json.dumps(
         {"system": ps.to_json(), "seed": seed, "bertini2": bertini2_version(), "start": start},
         sort_keys=True,
@@ -138,59 +146,77 @@ def generic_key(ps: ParametricSystem, seed: int) -> str:
 _LOADED: dict[tuple[int, int], GenericSet] = {}
 
 
-def generic_set(ps: ParametricSystem, seed: int = 1, use_cache: bool = True) -> GenericSet:
-    """The generic solution set of `ps` for `seed`, from memory, the disk cache, or solved."""
+def generic_set(
+    ps: ParametricSystem,
+    seed: int = 1,
+    use_cache: bool = True,
+    centre: dict[str, float] | None = None,
+    groups: list[list[str]] | None = None,
+) -> GenericSet:
+    """The generic solution set of `ps` for `seed`, from memory, the disk cache, or solved.
+
+    Its start parameters are `centre` (default: the paper's case 3, normalised) plus a random
+    complex perturbation of size START_SPREAD in every parameter. With variable `groups` the
+    ab-initio solve starts from a multihomogeneous start system (fewer paths)."""
     if use_cache and (id(ps), seed) in _LOADED:  # ps objects live as long as the process
         return _LOADED[id(ps), seed]
-    gs = _load_or_solve(ps, seed, use_cache)
+    centre = START_CENTRE if centre is None else centre
+    gs = _load_or_solve(ps, seed, use_cache, centre, groups)
     if use_cache:
         _LOADED[id(ps), seed] = gs
     return gs
 
 
-def _load_or_solve(ps: ParametricSystem, seed: int, use_cache: bool) -> GenericSet:
-    key = generic_key(ps, seed)
+def _load_or_solve(
+    ps: ParametricSystem, seed: int, use_cache: bool, centre: dict, groups
+) -> GenericSet:
+    key = generic_key(ps, seed, centre, groups)
     path = cache_root() / f"generic-{key}.json"
     if use_cache and path.is_file():
         try:
             return GenericSet.from_json(json.loads(path.read_text()))
         except (ValueError, KeyError):
             path.unlink(missing_ok=True)  # a damaged cache entry is recomputed, not trusted
-    _announce(ps, seed, path if use_cache else None)
-    gs = _solve_generic(ps, seed, key)
+    _announce(ps, seed, path if use_cache else None, groups)
+    gs = _solve_generic(ps, seed, key, centre, groups)
     if use_cache:
         atomic_write_text(path, json.dumps(gs.to_json()))
     return gs
 
 
-def _announce(ps: ParametricSystem, seed: int, stored: Path | None) -> None:
+def _announce(ps: ParametricSystem, seed: int, stored: Path | None, groups=None) -> None:
     """One line on stderr before a generic solve long enough to be noticed: what, how long."""
     paths = ps.instantiate([1.0 + 0.1j * k for k in range(len(ps.parameters))]).total_degree
     seconds = paths * SECONDS_PER_PATH
+    if groups:  # a multihomogeneous start has fewer paths than the total degree: a bound
+        paths, seconds = f"at most {paths}", f"up to {seconds:.0f}"
     if seconds < ANNOUNCE_SECONDS:
         return
     where = f"once: kept in {stored} for every later solve" if stored else "not cached"
     print(
         f"cotm-bertini: solving the generic solution set of these equations for seed {seed} "
-        f"({paths} paths, roughly {seconds:.0f} s; {where})",
+        f"({paths} paths, roughly {seconds if isinstance(seconds, str) else f'{seconds:.0f}'} s;"
+        f" {where})",
         file=sys.stderr,
         flush=True,
     )
 
 
-def _solve_generic(ps: ParametricSystem, seed: int, key: str) -> GenericSet:
+def _solve_generic(
+    ps: ParametricSystem, seed: int, key: str, centre: dict, groups=None
+) -> GenericSet:
     bertini = _bertini()
     from bertini import nag_algorithm as na
 
     rng = np.random.default_rng(seed)
     start = {
-        name: START_CENTRE[name] + START_SPREAD * complex(*rng.normal(size=2)) / np.sqrt(2)
+        name: centre[name] + START_SPREAD * complex(*rng.normal(size=2)) / np.sqrt(2)
         for name in ps.parameters
     }
     system = ps.instantiate([start[n] for n in ps.parameters])
     bertini.random.set_random_seed(seed)
     t0 = time.perf_counter()
-    solver = na.ZeroDimSolver(bertini.parse.system(render_system(system)))
+    solver = na.ZeroDimSolver(bertini.parse.system(render_system(system, groups)))
     solver.solve(show_progress=True)  # a bar on a terminal after 5 s; silent otherwise
     seconds = time.perf_counter() - t0
     meta, pts = solver.solution_metadata(), solver.all_solutions()
@@ -284,10 +310,17 @@ def _track(
     return solver.solution_metadata(), solver.all_solutions()
 
 
+def parameter_values(ps: ParametricSystem, params: Params | Mapping[str, float]) -> dict:
+    """The values of `ps`'s parameters: from a mapping (a framework's slots) or a Params."""
+    if isinstance(params, Mapping):
+        return {n: params[n] for n in ps.parameters}
+    return {n: getattr(params, n) for n in ps.parameters}
+
+
 def track(
     ps: ParametricSystem,
     gs: GenericSet,
-    params: Params,
+    params: Params | Mapping[str, float],
     settings: Settings = Settings(),
     deadline: float | None = None,
 ) -> tuple[Endpoints, TrackReport]:
@@ -298,7 +331,7 @@ def track(
     still fails is counted as lost (the caller re-solves).
     """
     t0 = time.perf_counter()
-    target = {n: getattr(params, n) for n in ps.parameters}
+    target = parameter_values(ps, params)
     texts = (
         render_parameter_homotopy(ps, gs.start, target),
         render_system(ps.instantiate([target[n] for n in ps.parameters])),
@@ -387,7 +420,7 @@ def zero_length_roots(params: Params, variables: tuple[str, ...]) -> Endpoints:
 
 
 def ab_initio(
-    ps: ParametricSystem, params: Params, settings: Settings = Settings()
+    ps: ParametricSystem, params: Params | Mapping[str, float], settings: Settings = Settings()
 ) -> tuple[Endpoints, int]:
     """Total-degree solve at the target itself (in-process): the last resort.
 
@@ -398,7 +431,8 @@ def ab_initio(
     from bertini import nag_algorithm as na
 
     bertini.random.set_random_seed(settings.seed)
-    system = ps.instantiate([getattr(params, n) for n in ps.parameters])
+    values = parameter_values(ps, params)
+    system = ps.instantiate([values[n] for n in ps.parameters])
     solver = na.ZeroDimSolver(bertini.parse.system(render_system(system)))
     if settings.threads is not None:
         solver.set(num_threads=settings.threads)

@@ -113,12 +113,13 @@ def render_input(
     )
 
 
-def render_system(system: PolySystem) -> str:
-    """A bare INPUT section (no CONFIG) for Bertini 2's in-process parser; complex allowed."""
+def render_system(system: PolySystem, groups: list[list[str]] | None = None) -> str:
+    """A bare INPUT section (no CONFIG) for Bertini 2's in-process parser; complex allowed.
+    With `groups`, one variable_group each (Bertini then starts multihomogeneously)."""
     return (
         _environment()
         .get_template("system.input.j2")
-        .render(variables=system.variables, functions=_functions(system))
+        .render(groups=groups or [list(system.variables)], functions=_functions(system))
     )
 
 

@@ -63,12 +63,18 @@ def solve_target(
         if result is None:
             result, note = continue_from(ps, gs, warm, params, settings, deadline)
     if result is None:
-        result = _from_generic(ps, gs, unit, settings, deadline)
+        result = from_generic(ps, gs, unit, settings, deadline)
         if note:
             result[1]["method"] += f" ({note})"
     endpoints, info, text = result
     complete = info["lost"] == 0 and info["finite"] == len(gs.points)
-    warm_next = WarmStart(params, endpoints.points, gs.key) if complete else None
+    warm_next = None
+    if complete:  # from a neighbour, the solutions come in its order: a secant start next
+        continued = warm is not None and info["method"].startswith(("Newton", "continued"))
+        if continued:
+            warm_next = warm.next_to(params, endpoints.points, gs.key)
+        else:
+            warm_next = WarmStart(params, endpoints.points, gs.key)
     is_d = np.array([v.startswith("d") for v in ps.variables])
     scaled = np.where(is_d, endpoints.points * params.L3, endpoints.points)
     endpoints = endpoints.with_points(scaled)
@@ -82,12 +88,22 @@ def solve_target(
     return HomotopySolve(endpoints.concat(closed), info, gs, text, warm_next)
 
 
-def _from_generic(ps, gs: GenericSet, unit: Params, settings: Settings, deadline) -> tuple:
-    """Track the generic set to the (normalised) target, with the fallbacks of solve_target."""
+def from_generic(
+    ps,
+    gs: GenericSet,
+    unit,
+    settings: Settings,
+    deadline,
+    centre: dict | None = None,
+    groups: list[list[str]] | None = None,
+) -> tuple:
+    """Track the generic set to the (normalised) target, with the fallbacks of solve_target:
+    (endpoints, info, homotopy input text). `unit`: a Params or a mapping of parameter values;
+    `centre`: the generic sets' start centre (default: the paper's)."""
     endpoints, rep = track(ps, gs, unit, settings, deadline)
     method = "parameter homotopy" + (" + adaptive retrack" if rep.retracked_adaptive else "")
     if rep.lost or rep.finite < len(gs.points):
-        gs2 = generic_set(ps, settings.seed + SECOND_START)
+        gs2 = generic_set(ps, settings.seed + SECOND_START, centre=centre, groups=groups)
         endpoints2, rep2 = track(ps, gs2, unit, settings, deadline)
         if rep2.lost == 0 and not rep.lost and rep2.finite == rep.finite:
             method += "; finite count confirmed from a second start"
@@ -99,3 +115,45 @@ def _from_generic(ps, gs: GenericSet, unit: Params, settings: Settings, deadline
             rep.finite, rep.lost = len(endpoints), lost
             method = "ab initio (both parameter homotopies lost paths)"
     return endpoints, {**rep.as_dict(), "method": method}, rep.input_text
+
+
+def solve_parameters(
+    ps: ParametricSystem,
+    target: dict[str, float],
+    centre: dict[str, float],
+    settings: Settings = Settings(),
+    groups: list[list[str]] | None = None,
+) -> HomotopySolve:
+    """Every finite endpoint of `ps` at `target` (normalised parameter values), from the generic
+    set around `centre`, with the fallbacks of solve_target; a second, independent generic set
+    is solved too and its count recorded (`info["generic_counts"]`): two ab-initio solves with
+    different random starts that agree are the completeness evidence of a framework solve.
+    `groups`: variable groups of a multihomogeneous start for the ab-initio solves."""
+    deadline = None if settings.timeout is None else time.perf_counter() + settings.timeout
+    centre = {n: centre[n] for n in ps.parameters}
+    gs = generic_set(ps, settings.seed, centre=centre, groups=groups)
+    gs2 = generic_set(ps, settings.seed + SECOND_START, centre=centre, groups=groups)
+    if ps.parameters:
+        endpoints, info, text = from_generic(ps, gs, target, settings, deadline, centre, groups)
+    else:  # nothing to move: the generic set is the answer
+        records = [{"path_number": k, "coords": p} for k, p in enumerate(gs.points)]
+        endpoints = Endpoints.from_records(ps.variables, records)
+        info = {
+            "tracked": gs.paths,
+            "finite": len(records),
+            "infinite": gs.paths - gs.finite_endpoints,
+            "retracked_adaptive": 0,
+            "lost": 0,
+            "method": "ab initio (the system has no parameters)",
+            "seconds": gs.seconds,
+            "notes": "",
+        }
+        text = ""
+    info.update(
+        generic_key=gs.key,
+        generic_paths=gs.paths,
+        generic_finite=gs.finite_endpoints,
+        generic_singular=gs.singular_endpoints,
+        generic_counts=[len(gs.points), len(gs2.points)],
+    )
+    return HomotopySolve(endpoints, info, gs, text)

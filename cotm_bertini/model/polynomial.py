@@ -46,7 +46,7 @@ class ParametricSystem:
             tuple(data["names"]),
             tuple(data["parameters"]),
             tuple(np.array(e, dtype=np.int64).reshape(-1, nv) for e in data["var_exps"]),
-            tuple(np.array(e, dtype=np.int64).reshape(-1, npar) for e in data["par_exps"]),
+            tuple(np.array(e, dtype=np.int64).reshape(len(e), npar) for e in data["par_exps"]),
             tuple(np.array(c, dtype=float) for c in data["coeffs"]),
             tuple(data["texts"]),
         )
@@ -82,13 +82,18 @@ class ParametricSystem:
             (),
         )
 
+    @cached_property
+    def _monomials(self) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
+        # Per function: its distinct monomials in the variables, and which one each term is
+        # (independent of the parameter values, so found once, not at every instantiate).
+        return tuple(np.unique(ve, axis=0, return_inverse=True) for ve in self.var_exps)
+
     def instantiate(self, values: Sequence[complex]) -> PolySystem:
         """The numeric system at parameter values (same order as `parameters`)."""
         p = np.asarray(values)
         exps, cfs = [], []
-        for ve, pe, c in zip(self.var_exps, self.par_exps, self.coeffs, strict=True):
+        for (uniq, inverse), pe, c in zip(self._monomials, self.par_exps, self.coeffs, strict=True):
             term = c * np.prod(p[None, :] ** pe, axis=1)
-            uniq, inverse = np.unique(ve, axis=0, return_inverse=True)
             total = np.zeros(len(uniq), dtype=term.dtype)
             np.add.at(total, inverse.ravel(), term)
             keep = total != 0

@@ -1,0 +1,187 @@
+"""Completeness of a framework solve: generic counts, lost paths, continua, the Morse count."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..model.framework.compiled import FrameworkSystem, framework_system, slot_vector
+from ..model.framework.derive import layout
+from ..model.framework.spec import Framework
+from ..model.framework.units import normalized_slots
+from ..settings import Settings
+from .framework_classify import column_names, positions
+
+_GROUP_KEYS = ("physical", "is_real")
+
+
+def order_rows(fw: Framework, parts: list[dict]) -> dict[str, np.ndarray]:
+    """The rows of every taut set in one table: physical, then real, then complex; within a
+    group by energy, then by the pose columns; ids 1, 2, ... in that order."""
+    names = column_names(fw)
+    if not parts:
+        return {n: np.zeros(0) for n in names}
+    cols = {n: np.concatenate([p[n] for p in parts]) for n in names if n != "solution_id"}
+    group = np.where(cols["physical"], 0, np.where(cols["is_real"], 1, 2))
+    pose = [np.round(cols[n], 9) for n in reversed(names[1:4]) if n in cols]
+    order = np.lexsort((*pose, np.round(cols["energy"], 9), group))
+    out = {"solution_id": np.arange(1, len(order) + 1)}
+    out.update({n: cols[n][order] for n in names if n != "solution_id"})
+    return out
+
+
+def framework_counts(table: dict, report: dict) -> dict:
+    """Paths tracked, endpoints and solution counts over every taut set."""
+    solved = [r for r in report.values() if "tracked" in r]
+    return {
+        "paths_tracked": sum(r["tracked"] for r in solved),
+        "finite_endpoints": sum(r["finite"] for r in solved),
+        "closed_form_endpoints": 0,
+        "infinite_or_failed_paths": sum(r["tracked"] - r["finite"] for r in solved),
+        "lost_paths": sum(r["lost"] for r in solved),
+        "generic_paths": sum(r["generic_paths"] for r in solved),
+        "distinct_solutions": len(table["solution_id"]),
+        "real": int(np.sum(table["is_real"])),
+        "physical": int(np.sum(table["physical"])),
+        "stable": int(np.sum(table["stable"])),
+        "singular": int(np.sum(table["singular"])),
+        "taut_sets_solved": len(solved),
+        "taut_sets_continuum": len(report) - len(solved),
+    }
+
+
+def completeness(fw: Framework, table: dict, report: dict) -> dict:
+    """Why no equilibrium is missing, or warnings saying why one may be: {"morse", "warnings"}."""
+    warnings = []
+    for label, info in report.items():
+        if "tracked" not in info:
+            if not info["excluded"]:
+                warnings.append(f"taut set {label}: {info['note']}")
+            continue
+        a, b = info["generic_counts"]
+        if a != b:
+            warnings.append(
+                f"taut set {label}: two independent generic solves disagree ({a} vs {b} roots)"
+            )
+        if info["lost"]:
+            warnings.append(f"taut set {label}: {info['lost']} paths lost")
+        if info["generic_singular"]:
+            warnings.append(
+                f"taut set {label}: {info['generic_singular']} singular endpoints at generic "
+                "parameters (a positive-dimensional solution set, not enumerated)"
+            )
+    morse = morse_count(fw, table)
+    if morse["applicable"] and not morse["ok"]:
+        warnings.append(
+            f"Morse count on the torus {morse['euler_characteristic']} != 0"
+            + (f" ({morse['degenerate']} degenerate)" if morse["degenerate"] else "")
+            + ": equilibria may be missing"
+        )
+    return {"morse": morse, "warnings": warnings}
+
+
+def morse_count(fw: Framework, table: dict) -> dict:
+    """sum (-1)^index over the physical equilibria plus the cone maxima: 0 on a torus T^n."""
+    lay = layout(fw)
+    if fw.dim != 2 or not lay.is_torus:
+        return {"applicable": False, "ok": None, "reason": "the configuration space is not a "
+                "circle or torus (translations, nodes or closed loops)"}  # fmt: skip
+    phys = np.asarray(table["physical"], dtype=bool)
+    kinds = np.asarray(table["kind"], dtype=object)[phys]
+    index = np.asarray(table["index"], dtype=int)[phys]
+    n = len(lay.rotations)
+    counts = {k: int((kinds == k).sum()) for k in ("min", "saddle", "max", "degenerate")}
+    cones = cone_points(fw)
+    maxima = sum(c["is_max"] for c in cones)
+    total = int(sum((-1) ** int(i) for i, k in zip(index, kinds, strict=True) if k != "degenerate"))
+    total += maxima * (-1) ** n
+    ok = total == 0 and counts["degenerate"] == 0
+    return {"applicable": True, "torus_dimension": n, **counts, "zero_length_maxima": maxima,
+            "euler_characteristic": total, "ok": ok}  # fmt: skip
+
+
+def cone_points(fw: Framework) -> list[dict]:
+    """Real poses of a two-body planar torus where a spring with L0 > 0 has zero length; each is
+    a local maximum of V (a cone) when the other elements' pull there is weaker than k L0."""
+    fs = framework_system(fw, tuple(c.name for c in fw.cables))
+    if not fs.cones:
+        return []
+    from ..backends.homotopy import ab_initio
+
+    slots_n = normalized_slots(fw)
+    found = []
+    for name, ps in fs.cones.items():
+        ends, _ = ab_initio(ps, {n: slots_n[n] for n in ps.parameters}, Settings())
+        for pose in ends.points:
+            if np.abs(pose.imag).max() > 1e-8:
+                continue
+            pull, push = _cone_pull(fw, fs, name, pose.real, slots_n)
+            found.append({"spring": name, "pose": pose.real.tolist(), "pull": pull,
+                          "push": push, "is_max": pull < push})  # fmt: skip
+    return found
+
+
+def _cone_pull(fw, fs: FrameworkSystem, name: str, pose, slots_n) -> tuple[float, float]:
+    """|J^-T g| (g: every other element's energy gradient) and k L0 of the collapsed spring."""
+    X = np.zeros((1, len(fs.ps.variables)))
+    X[0, : len(pose)] = pose
+    P = np.array(list(slots_n.values()))[None, :]
+    vals = [float(np.asarray(v).reshape(-1)[0]) for v in fs.numeric.first_order(X, P)]
+    m, dim = fs.local_size, fw.dim
+    grad, jac = np.array(vals[-m:]), None
+    for k, link in enumerate(fs.active):
+        block = vals[k * (dim + dim * m) : (k + 1) * (dim + dim * m)]
+        r, J = np.array(block[:dim]), np.array(block[dim:]).reshape(dim, m)
+        if link == name:
+            jac = J
+            continue
+        length = float(np.linalg.norm(r))
+        L0 = slots_n[f"L0_{link}"]
+        stretch = length - L0
+        if any(c.name == link for c in fw.cables):
+            stretch = max(stretch, 0.0)
+        if length > 0:
+            grad = grad + slots_n[f"k_{link}"] * stretch / length * (J.T @ r)
+    push = slots_n[f"k_{name}"] * slots_n[f"L0_{name}"]
+    return float(np.linalg.norm(np.linalg.solve(jac.T, grad))), float(push)
+
+
+def continuum_check(fw: Framework, fs: FrameworkSystem, unit: tuple[float, float]) -> dict:
+    """Whether a taut set whose equations leave a direction free can hold at all: it needs every
+    other cable slack at once. On a circle or torus this is decided on a grid with a Lipschitz
+    margin (a proof that no pose has them all slack); elsewhere it is not decided."""
+    slack = [c for c in fw.cables if c.name not in fs.taut]
+    lay = layout(fw)
+    if not slack:
+        return {"excluded": False, "note": f"nothing resists {fs.free[0]}: a continuum"}
+    if fw.dim != 2 or not lay.is_torus:
+        return {"excluded": False, "note": f"with {', '.join(c.name for c in slack)} slack, "
+                f"nothing resists {fs.free[0]}: a possible continuum, not enumerated"}  # fmt: skip
+    n = len(lay.rotations)
+    steps = {1: 7200, 2: 720}.get(n, 60)
+    h = 2 * np.pi / steps
+    axes = np.meshgrid(*([np.arange(steps) * h] * n), indexing="ij")
+    X = np.zeros((axes[0].size, len(fs.ps.variables)))
+    for k, theta in enumerate(axes):
+        X[:, 2 * k], X[:, 2 * k + 1] = np.cos(theta.ravel()), np.sin(theta.ravel())
+    slots = fw.slots()
+    where = positions(fs, X, slot_vector(normalized_slots(fw)), 2, unit[0])
+    where = {p: v.real for p, v in where.items()}
+    excess = np.max([np.linalg.norm(where[c.a] - where[c.b], axis=1) - slots[f"L0_{c.name}"]
+                     for c in slack], axis=0)  # fmt: skip
+    margin = n * _radius_sum(fw) * h
+    excluded = bool((excess > margin).all())
+    what = ", ".join(c.name for c in slack)
+    note = (f"no pose has {what} all slack (grid of {steps}^{n} poses, Lipschitz margin "
+            f"{margin:.3g}: proved)" if excluded else
+            f"{what} can all be slack: nothing then resists {fs.free[0]}, a continuum of "
+            "equilibria may exist (not enumerated)")  # fmt: skip
+    return {"excluded": excluded, "note": note, "min_excess": float(excess.min())}
+
+
+def _radius_sum(fw: Framework) -> float:
+    """Sum over bodies of the largest distance between two of its points (a lever-arm bound)."""
+    vals, total = fw.values, 0.0
+    for _, pts in fw.bodies:
+        xy = np.array([[e.evaluate(vals) for e in c] for _, c in pts])
+        total += float(np.max(np.linalg.norm(xy[:, None] - xy[None], axis=2)))
+    return total

@@ -1,0 +1,98 @@
+"""A framework's equations as numbers: derived once per structure, cached on disk.
+
+A structure is the framework's topology with a taut set of cables and its zero-free-length
+springs; its parametric system (in the slots) and generated numpy code are kept under the cache
+folder, keyed by a hash of the structure and of the derivation code, so a solve needs no sympy.
+"""
+
+from __future__ import annotations
+
+import json
+import types
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from ...fs import atomic_write_text, cache_root
+from ..polynomial import ParametricSystem
+from .derive import Derived, structure_key
+from .spec import Framework
+from .units import scale_of
+
+
+@dataclass(frozen=True, eq=False)
+class FrameworkSystem:
+    """One structure's equations: the parametric system and the numeric helpers."""
+
+    key: str
+    taut: tuple[str, ...]
+    ps: ParametricSystem
+    kinds: tuple[str, ...]
+    descriptions: tuple[str, ...]
+    free: tuple[str, ...]
+    points: tuple[str, ...]
+    local_size: int
+    constraints: int
+    numeric: types.ModuleType  # positions, hessian, constraint_jacobian, first_order (X, P)
+    active: tuple[str, ...]  # springs and taut cables, as first_order lists them
+    cones: dict[str, ParametricSystem]  # zero-length poses of each spring (two-body torus)
+
+
+_LOADED: dict[str, FrameworkSystem] = {}
+
+
+def framework_system(fw: Framework, taut: tuple[str, ...]) -> FrameworkSystem:
+    """The structure's system, from memory, the disk cache, or derived with sympy."""
+    key = structure_key(fw, taut)
+    if key in _LOADED:
+        return _LOADED[key]
+    path = cache_root() / "frameworks" / f"system-{key}.json"
+    derived = None
+    if path.is_file():
+        try:
+            derived = Derived(**json.loads(path.read_text()))
+        except (ValueError, TypeError):
+            derived = None  # damaged: derive again
+    if derived is None:
+        from .derive import derive
+
+        derived = derive(fw, tuple(sorted(taut)))
+        atomic_write_text(path, json.dumps(asdict(derived)))
+    module = types.ModuleType(f"cotm_framework_{key}")
+    exec(compile(derived.source, str(path), "exec"), module.__dict__)
+    out = FrameworkSystem(
+        key, tuple(sorted(taut)), ParametricSystem.from_json(derived.system),
+        tuple(derived.kinds), tuple(derived.descriptions), tuple(derived.free),
+        tuple(derived.points), derived.local_size, derived.constraints, module,
+        tuple(derived.active),
+        {k: ParametricSystem.from_json(v) for k, v in derived.cones.items()},
+    )  # fmt: skip
+    _LOADED[key] = out
+    return out
+
+
+def variable_groups(fs: FrameworkSystem) -> list[list[str]]:
+    """Variable groups of a multihomogeneous start: each body's rotation, all translations and
+    node coordinates together, and each length, force density and multiplier on its own (on
+    the paper's mechanism 224 paths instead of a total degree of 576)."""
+    groups: dict[str, list[str]] = {}
+    for v in fs.ps.variables:
+        head, _, rest = v.partition("_")
+        if head in ("c", "s") or head.startswith("q"):
+            key = "rot " + rest
+        elif head in ("t", "n"):
+            key = "positions"
+        else:
+            key = v
+        groups.setdefault(key, []).append(v)
+    return list(groups.values())
+
+
+def variable_scale(fs: FrameworkSystem, unit: tuple[float, float]) -> np.ndarray:
+    """The unit of each solver variable (multiply a normalised solution by it)."""
+    return np.array([scale_of(k, *unit) for k in fs.kinds])
+
+
+def slot_vector(slots: dict[str, float]) -> np.ndarray:
+    """Every slot's value in the order the generated code reads them (the framework's order)."""
+    return np.array(list(slots.values()), dtype=float)

@@ -1,0 +1,400 @@
+"""The equilibrium equations of a framework, derived with sympy in reduced coordinates.
+
+Unknowns: a rotation per body (planar: c, s with c^2 + s^2 = 1; spatial: a unit quaternion), the
+translation of each body and the coordinates of each node that no pin places, a force density
+w and a length d per spring or taut cable with a free length (w d = k (d - L0), d^2 = |r|^2), and
+a multiplier per bar and per pin that closes a loop. Pins that attach a body or node to
+something already placed are eliminated by substitution (an open chain pinned to the ground
+has its rotations as its only unknowns). The balance equations are the gradient of
+E = sum w/2 |r|^2 - sum F . x + sum mu g along every unknown direction: for a planar rotation
+the moment -s dE/dc + c dE/ds, for a quaternion the three torques t_i . dE/dq with t_i = q e_i.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass
+from functools import cache
+from pathlib import Path
+
+import sympy as sp
+
+from ...errors import ParameterError
+from .spec import Framework, owner, point_names
+from .units import constants
+
+_AXES = "xyz"
+
+
+@dataclass(frozen=True)
+class Layout:
+    """Which unknowns a framework has once pins have placed what they can."""
+
+    rotations: tuple[str, ...]  # every body
+    translations: tuple[str, ...]  # bodies whose translation is unknown
+    free_nodes: tuple[str, ...]
+    placed_by: tuple[tuple[str, str, str], ...]  # (entity, its pinned point, the point it is at)
+    closing_pins: tuple[int, ...]  # pins left as constraints (0-based)
+
+    @property
+    def is_torus(self) -> bool:
+        """Only rotations: the configuration space of a planar framework is a circle or torus."""
+        return not (self.translations or self.free_nodes or self.closing_pins)
+
+
+def layout(fw: Framework) -> Layout:
+    """Place bodies and nodes through pins to placed entities, in file order, until none moves."""
+    placed = {"ground"}
+    placed_by, used = [], set()
+    changed = True
+    while changed:
+        changed = False
+        for k, (a, b) in enumerate(fw.pins):
+            if k in used:
+                continue
+            for src, dst in ((a, b), (b, a)):
+                if owner(src) in placed and owner(dst) not in placed:
+                    placed.add(owner(dst))
+                    placed_by.append((owner(dst), dst, src))
+                    used.add(k)
+                    changed = True
+                    break
+    bodies = tuple(b for b, _ in fw.bodies)
+    return Layout(
+        rotations=bodies,
+        translations=tuple(b for b in bodies if b not in placed),
+        free_nodes=tuple(n for n in fw.nodes if n not in placed),
+        placed_by=tuple(placed_by),
+        closing_pins=tuple(k for k in range(len(fw.pins)) if k not in used),
+    )
+
+
+def _rotation(dim: int, q: list) -> sp.Matrix:
+    if dim == 2:
+        c, s = q
+        return sp.Matrix([[c, -s], [s, c]])
+    w, x, y, z = q
+    return sp.Matrix(
+        [
+            [w * w + x * x - y * y - z * z, 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), w * w - x * x + y * y - z * z, 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), w * w - x * x - y * y + z * z],
+        ]
+    )
+
+
+def quaternion_product(a: list, b: list) -> list:
+    """The Hamilton product a b of quaternions (w, x, y, z)."""
+    a1, b1, c1, d1 = a
+    a2, b2, c2, d2 = b
+    return [
+        a1 * a2 - b1 * b2 - c1 * c2 - d1 * d2,
+        a1 * b2 + b1 * a2 + c1 * d2 - d1 * c2,
+        a1 * c2 - b1 * d2 + c1 * a2 + d1 * b2,
+        a1 * d2 + b1 * c2 - c1 * b2 + d1 * a2,
+    ]
+
+
+def rotation_names(dim: int, body: str) -> list[str]:
+    """Solver variable names of a body's rotation."""
+    return [f"c_{body}", f"s_{body}"] if dim == 2 else [f"q{a}_{body}" for a in "wxyz"]
+
+
+class _Positions:
+    """World coordinates of every point as sympy expressions, given each body's rotation."""
+
+    def __init__(self, fw: Framework, lay: Layout, rot: dict[str, sp.Matrix]):
+        self.fw, self.lay, self.rot = fw, lay, rot
+        self.placed = {e: (pt, src) for e, pt, src in lay.placed_by}
+        self.cache: dict[str, sp.Matrix] = {}
+
+    def local(self, point: str) -> sp.Matrix:
+        body, name = point.split(".", 1)
+        return sp.Matrix([sp.Symbol(f"b_{body}_{name}_{a}") for a in _AXES[: self.fw.dim]])
+
+    def translation(self, body: str) -> sp.Matrix:
+        if body in self.placed:
+            pt, src = self.placed[body]
+            return self.of(src) - self.rot[body] * self.local(pt)
+        return sp.Matrix([sp.Symbol(f"t_{body}_{a}") for a in _AXES[: self.fw.dim]])
+
+    def of(self, point: str) -> sp.Matrix:
+        """The point's world coordinates."""
+        if point not in self.cache:
+            ent = owner(point)
+            dim = self.fw.dim
+            if ent == "ground":
+                name = point.split(".", 1)[1]
+                out = sp.Matrix([sp.Symbol(f"g_{name}_{a}") for a in _AXES[:dim]])
+            elif ent in self.fw.nodes:
+                if ent in self.placed:
+                    out = self.of(self.placed[ent][1])
+                else:
+                    out = sp.Matrix([sp.Symbol(f"n_{ent}_{a}") for a in _AXES[:dim]])
+            else:
+                out = self.translation(ent) + self.rot[ent] * self.local(point)
+            self.cache[point] = out
+        return self.cache[point]
+
+
+def structure(fw: Framework, taut: tuple[str, ...]) -> dict:
+    """What the equations depend on: topology, taut cables, zero free lengths, constant slots."""
+    return {
+        "dim": fw.dim,
+        "nodes": list(fw.nodes),
+        "ground": [g for g, _ in fw.ground],
+        "bodies": [[b, [p for p, _ in pts]] for b, pts in fw.bodies],
+        "pins": [list(p) for p in fw.pins],
+        "links": [[x.kind, x.name, x.a, x.b] for x in fw.links],
+        "loads": [[x.name, x.point] for x in fw.loads],
+        "taut": sorted(taut),
+        "zfl": sorted(fw.zero_free_length()),
+        "constants": constants(fw),
+    }
+
+
+@dataclass(frozen=True)
+class Derived:
+    """The derivation's result as plain data (JSON-able), with the generated numpy source."""
+
+    system: dict  # ParametricSystem.to_json()
+    kinds: list[str]  # per variable: rot, len, k or force (how it scales with the units)
+    descriptions: list[str]  # per equation: what it balances or constrains
+    free: list[str]  # identically zero equations: directions nothing resists
+    points: list[str]  # positions() returns these points' coordinates, in this order
+    local_size: int  # size of the local coordinates of the Hessian
+    constraints: int  # rows of the constraint Jacobian
+    source: str  # numpy source: positions, hessian, constraint_jacobian, first_order
+    active: list[str]  # springs and taut cables, in the order first_order gives them
+    cones: dict  # spring -> ParametricSystem JSON of its zero-length poses (two-body torus)
+
+
+def _active(fw: Framework, taut: tuple[str, ...]) -> list:
+    return [x for x in fw.links if x.kind == "spring" or (x.kind == "cable" and x.name in taut)]
+
+
+def _unknowns(fw: Framework, lay: Layout) -> tuple[list[str], list[str]]:
+    """The configuration unknowns (rotations, free translations, free nodes) and their kinds."""
+    dim, variables, kinds = fw.dim, [], []
+    for b in lay.rotations:
+        names = rotation_names(dim, b)
+        variables += names
+        kinds += ["rot"] * len(names)
+    for b in lay.translations:
+        variables += [f"t_{b}_{a}" for a in _AXES[:dim]]
+    for n in lay.free_nodes:
+        variables += [f"n_{n}_{a}" for a in _AXES[:dim]]
+    return variables, kinds + ["len"] * (len(variables) - len(kinds))
+
+
+def _pseudo_energy(fw: Framework, lay: Layout, pos: _Positions, taut) -> tuple:
+    """E (whose gradient is the force balance), the extra unknowns, their kinds, and the
+    equations and descriptions of the springs' laws and of the constraints."""
+    zfl = set(fw.zero_free_length())
+    E, variables, kinds, equations, about = sp.Integer(0), [], [], [], []
+    for x in _active(fw, taut):
+        r = pos.of(x.a) - pos.of(x.b)
+        k = sp.Symbol(f"k_{x.name}")
+        w = k
+        if x.name not in zfl:
+            w, d, L0 = (sp.Symbol(f"{p}_{x.name}") for p in ("w", "d", "L0"))
+            variables += [d.name, w.name]
+            kinds += ["len", "k"]
+            equations += [d * d - r.dot(r), w * d - k * (d - L0)]
+            about += [f"{x.kind} {x.name}: length", f"{x.kind} {x.name}: force law"]
+        E += w / 2 * r.dot(r)
+    for load in fw.loads:
+        f = sp.Matrix([sp.Symbol(f"f_{load.name}_{a}") for a in _AXES[: fw.dim]])
+        E -= f.dot(pos.of(load.point))
+    for g, name, kind, what in _constraints(fw, lay, pos):
+        E += sp.Symbol(name) * g
+        variables.append(name)
+        kinds.append(kind)
+        equations.append(g)
+        about.append(what)
+    return E, variables, kinds, equations, about
+
+
+def derive(fw: Framework, taut: tuple[str, ...]) -> Derived:
+    """The equilibrium system of `fw` with the cables in `taut` taut and the others slack."""
+    from ..symbolic import numpy_function, parametric_from_sympy
+
+    lay = layout(fw)
+    const = {sp.Symbol(n): sp.Float(v, 17) for n, v in constants(fw).items()}
+    rot_syms = {b: [sp.Symbol(n) for n in rotation_names(fw.dim, b)] for b in lay.rotations}
+    pos = _Positions(fw, lay, {b: _rotation(fw.dim, q) for b, q in rot_syms.items()})
+    config, kinds = _unknowns(fw, lay)
+    E, extra, extra_kinds, laws, law_about = _pseudo_energy(fw, lay, pos, taut)
+    balance, about = _balance(E, fw.dim, lay, rot_syms, config)
+    equations = [sp.expand(f.xreplace(const)) for f in balance + laws]
+    descriptions = about + law_about
+    variables = config + extra
+    free = [descriptions[i] for i, f in enumerate(equations) if f == 0]
+    slots = [n for n in fw.slots()]
+    ps = parametric_from_sympy(
+        tuple(variables), tuple(f"f{i + 1}" for i in range(len(equations))),
+        tuple(equations), tuple(slots),
+    )  # fmt: skip
+    local, hess, cjac, firsts = _second_order(fw, lay, rot_syms, taut, config)
+    # Named points, then each body's frame origin under the body's own name.
+    points = sorted(point_names(fw)) + list(lay.rotations)
+    coords = [c for p in points[: -len(lay.rotations) or None] for c in pos.of(p)]
+    coords += [c for b in lay.rotations for c in pos.translation(b)]
+    args = {"X": [sp.Symbol(v) for v in variables], "P": [sp.Symbol(n) for n in slots]}
+    functions = {"positions": coords, "hessian": hess, "constraint_jacobian": cjac,
+                 "first_order": firsts}  # fmt: skip
+    source = "from numpy import sqrt, sin, cos\n\n" + "\n".join(
+        numpy_function(name, args, [e.xreplace(const) for e in exprs] or [sp.S(0)])
+        for name, exprs in functions.items()
+    )
+    cones = _cone_systems(fw, lay, pos, taut, slots, const)
+    return Derived(ps.to_json(), kinds + extra_kinds, descriptions, free, points, local,
+                   len(cjac) // max(local, 1), source, [x.name for x in _active(fw, taut)],
+                   cones)  # fmt: skip
+
+
+def _cone_systems(fw: Framework, lay: Layout, pos: _Positions, taut, slots, const) -> dict:
+    """Per spring with a free length (planar, two bodies, only rotations): the system whose
+    roots are the poses where the spring has zero length (V has a cone point there)."""
+    from ..symbolic import parametric_from_sympy
+
+    if not (lay.is_torus and len(lay.rotations) == fw.dim == 2):
+        return {}
+    zfl, out = set(fw.zero_free_length()), {}
+    unknowns = [n for b in lay.rotations for n in rotation_names(2, b)]
+    for x in _active(fw, taut):
+        r = (pos.of(x.a) - pos.of(x.b)).xreplace(const)
+        moves = {s.name for s in r.free_symbols} & set(unknowns)
+        if x.name in zfl or len(moves) < len(unknowns):
+            # A spring on one body collapses only for special parameter values (two equations
+            # on a circle): no cone point generically.
+            continue
+        eqs = [r[0], r[1]] + [
+            sp.Symbol(c) ** 2 + sp.Symbol(s) ** 2 - 1
+            for c, s in zip(unknowns[::2], unknowns[1::2], strict=True)
+        ]
+        ps = parametric_from_sympy(tuple(unknowns), ("z1", "z2", "z3", "z4"), tuple(eqs),
+                                   tuple(slots))  # fmt: skip
+        out[x.name] = ps.to_json()
+    return out
+
+
+def _constraints(fw: Framework, lay: Layout, pos: _Positions) -> list[tuple]:
+    """(g, multiplier name, unit kind, description) for every bar and loop-closing pin."""
+    out = []
+    for x in fw.bars:
+        r = pos.of(x.a) - pos.of(x.b)
+        g = (r.dot(r) - sp.Symbol(f"len_{x.name}") ** 2) / 2
+        out.append((g, f"mu_{x.name}", "k", f"bar {x.name}: length"))
+    for k in lay.closing_pins:
+        a, b = fw.pins[k]
+        gap = pos.of(a) - pos.of(b)
+        for i in range(fw.dim):
+            out.append((gap[i], f"mu_pin{k + 1}_{_AXES[i]}", "force", f"pin {k + 1}: {_AXES[i]}"))
+    return out
+
+
+def _balance(E, dim: int, lay: Layout, rot_syms: dict, config: list[str]) -> tuple[list, list]:
+    """Stationarity of E along every unknown direction, plus the unit-rotation equations."""
+    eqs, about = [], []
+    for b in lay.rotations:
+        q = rot_syms[b]
+        grad = [sp.diff(E, v) for v in q]
+        if dim == 2:
+            c, s = q
+            eqs += [-s * grad[0] + c * grad[1], c * c + s * s - 1]
+            about += [f"body {b}: moment", f"body {b}: unit rotation"]
+        else:
+            for axis, unit in zip("xyz", ([0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]), strict=True):
+                t = quaternion_product(q, unit)
+                eqs.append(sum(ti * gi for ti, gi in zip(t, grad, strict=True)))
+                about.append(f"body {b}: moment about {axis}")
+            eqs.append(sum(v * v for v in q) - 1)
+            about.append(f"body {b}: unit quaternion")
+    rotations = {n for b in lay.rotations for n in rotation_names(dim, b)}
+    for v in config:
+        if v not in rotations:
+            eqs.append(sp.diff(E, sp.Symbol(v)))
+            about.append(f"{v}: force balance")
+    return eqs, about
+
+
+def _second_order(fw: Framework, lay: Layout, rot_syms: dict, taut: tuple[str, ...],
+                  config: list[str]) -> tuple[int, list, list]:  # fmt: skip
+    """The Lagrangian's Hessian and the constraints' Jacobian in local coordinates.
+
+    A rotation is perturbed as R0 R(delta) (planar) or q0 (sqrt(1 - |v|^2), v) (spatial), so the
+    unit-length constraints are built in; translations and nodes are their own coordinates."""
+    dim = fw.dim
+    local, rot = [], {}
+    for b in lay.rotations:
+        q0 = rot_syms[b]
+        if dim == 2:
+            dl = sp.Symbol(f"delta_{b}")
+            local.append(dl)
+            rot[b] = _rotation(2, q0) * _rotation(2, [sp.cos(dl), sp.sin(dl)])
+        else:
+            v = [sp.Symbol(f"v{a}_{b}") for a in "xyz"]
+            local += v
+            unit = [sp.sqrt(1 - sum(t * t for t in v)), *v]
+            rot[b] = _rotation(3, quaternion_product(q0, unit))
+    trans = [sp.Symbol(v) for v in config if not any(v in rotation_names(dim, b)
+                                                    for b in lay.rotations)]  # fmt: skip
+    local += trans
+    pos = _Positions(fw, lay, rot)
+    V = sp.Integer(0)
+    zfl = set(fw.zero_free_length())
+    for x in _active(fw, taut):
+        r = pos.of(x.a) - pos.of(x.b)
+        k, L0 = sp.Symbol(f"k_{x.name}"), sp.Symbol(f"L0_{x.name}")
+        V += k / 2 * (r.dot(r) if x.name in zfl else (sp.sqrt(r.dot(r)) - L0) ** 2)
+    for load in fw.loads:
+        f = sp.Matrix([sp.Symbol(f"f_{load.name}_{a}") for a in _AXES[:dim]])
+        V -= f.dot(pos.of(load.point))
+    cons = _constraints(fw, lay, pos)
+    L = V + sum(sp.Symbol(name) * g for g, name, _, _ in cons)
+    at = {s: 0 for s in local[: len(local) - len(trans)]}
+    hess = [sp.diff(L, a, b).subs(at) for a in local for b in local]
+    cjac = [sp.diff(g, a).subs(at) for g, *_ in cons for a in local]
+    # First order, for cone points: each active link's vector r and dr/dlocal, and the loads'
+    # energy gradient.
+    firsts = []
+    for x in _active(fw, taut):
+        r = pos.of(x.a) - pos.of(x.b)
+        firsts += [ri.subs(at) for ri in r] + [sp.diff(ri, a).subs(at) for ri in r for a in local]
+    load_energy = sum(
+        (-sp.Matrix([sp.Symbol(f"f_{ld.name}_{a}") for a in _AXES[:dim]]).dot(pos.of(ld.point))
+         for ld in fw.loads), sp.Integer(0))  # fmt: skip
+    firsts += [sp.diff(load_energy, a).subs(at) for a in local]
+    return len(local), hess, cjac, firsts
+
+
+_SOURCES = tuple(
+    Path(__file__).resolve().parent.parent / f
+    for f in ("framework/derive.py", "framework/spec.py", "symbolic.py", "polynomial.py")
+)
+
+
+@cache
+def source_hash() -> str:
+    """A hash of the derivation's code: an edit derives every structure again."""
+    h = hashlib.sha256()
+    for path in _SOURCES:
+        h.update(path.read_bytes())
+    return h.hexdigest()[:16]
+
+
+def structure_key(fw: Framework, taut: tuple[str, ...]) -> str:
+    """Content hash of a structure and the derivation code."""
+    blob = json.dumps({"s": structure(fw, taut), "code": source_hash()}, sort_keys=True)
+    return hashlib.sha256(blob.encode()).hexdigest()[:16]
+
+
+def check_mobility(fw: Framework, derived: Derived) -> None:
+    """Refuse a framework that moves freely with every cable taut (a continuum of equilibria)."""
+    if derived.free:
+        raise ParameterError(
+            f"framework {fw.name!r} can move freely: nothing resists {derived.free[0]} "
+            "(a continuum of equilibria; add a spring, cable, bar or pin)"
+        )

@@ -1,0 +1,54 @@
+"""sympy expressions as the package's numeric forms: sparse parametric systems, numpy source."""
+
+from __future__ import annotations
+
+import numpy as np
+import sympy as sp
+
+from .polynomial import ParametricSystem
+
+
+def parametric_from_sympy(
+    variables: tuple[str, ...],
+    names: tuple[str, ...],
+    functions: tuple[sp.Expr, ...],
+    parameters: tuple[str, ...],
+) -> ParametricSystem:
+    """Polynomials in `variables` with coefficients polynomial in `parameters`, as terms.
+
+    Parameters that no function uses are dropped (the system's `parameters` lists the used ones
+    in the given order)."""
+    xs = [sp.Symbol(n) for n in variables]
+    used_names = {s.name for f in functions for s in f.free_symbols}
+    used = tuple(n for n in parameters if n in used_names)
+    ps = [sp.Symbol(n) for n in used]
+    var_exps, par_exps, coeffs, texts = [], [], [], []
+    for f in functions:
+        poly = sp.Poly(sp.expand(f), *xs, *ps)
+        terms = poly.terms()
+        var_exps.append(np.array([m[: len(xs)] for m, _ in terms], dtype=np.int64))
+        par_exps.append(np.array([m[len(xs) :] for m, _ in terms], dtype=np.int64))
+        coeffs.append(np.array([float(c) for _, c in terms], dtype=float))
+        texts.append(sp.sstr(f).replace("**", "^"))
+    return ParametricSystem(
+        tuple(variables), tuple(names), used, tuple(var_exps), tuple(par_exps), tuple(coeffs),
+        tuple(texts),
+    )  # fmt: skip
+
+
+def numpy_function(name: str, args: dict[str, list[sp.Symbol]], exprs: list[sp.Expr]) -> str:
+    """Source of `def name(<args>)` returning the list `exprs`, common subexpressions shared.
+
+    Each argument is an array whose last axis holds the listed symbols in order."""
+    from sympy.printing.numpy import NumPyPrinter
+
+    printer = NumPyPrinter({"fully_qualified_modules": False})
+    lines = [f"def {name}({', '.join(args)}):"]
+    for arg, symbols in args.items():
+        for k, s in enumerate(symbols):
+            lines.append(f"    {s.name} = {arg}[..., {k}]")
+    subs, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("_t"))
+    for sym, expr in subs:
+        lines.append(f"    {sym} = {printer.doprint(expr)}")
+    lines.append(f"    return [{', '.join(printer.doprint(e) for e in reduced)}]")
+    return "\n".join(lines) + "\n"

@@ -81,13 +81,14 @@ FOLDS = {
     "L01, L02": "the free lengths (m) of the fold point (either may be negative: not physical)",
     "gamma1_deg, gamma2_deg": "the equilibrium's angles (deg) in [0, 360)",
     "d1, d2": "the spring lengths (m)",
-    "physical": "both free lengths >= 0",
+    "physical": "both free lengths >= 0, and not zero_length",
     "family": "relaxed (both springs at their free length: L0 = d) or tensioned (the pose on the "
     "parallel curve with free lengths on its line)",
     "curve_id": "the connected piece of the fold set the point belongs to (points of one family "
     "within 1 deg in pose and 0.05 L3 in free length are joined)",
-    "kind": "fold, or cusp: where a fold curve stops and turns back (a degenerate fold; its "
-    "curve_id is -1)",
+    "kind": "fold; cusp: where a fold curve stops and turns back (a degenerate fold; its "
+    "curve_id is -1); or zero_length: a spring shorter than the solutions' zero-length rule "
+    "(1e-5 L3), where V is not smooth and a fold curve ends (not physical)",
     "hess_eig_min": "the Hessian eigenvalue nearest zero (J/rad^2): 0 at a fold, up to rounding",
 }
 

@@ -4,6 +4,7 @@ physical equilibria, and the paper's 1-D fold (L01 = 11.0128 m at L02 = 0) lies 
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import subprocess
@@ -15,6 +16,8 @@ import pytest
 
 import cotm_bertini as cb
 from cotm_bertini.model.compiled import energy_gradient, energy_hessian
+from cotm_bertini.point import solve_point
+from cotm_bertini.settings import Tolerances
 
 P = cb.Params.case("case3")
 
@@ -129,6 +132,31 @@ def test_map_writes_folds_regions_and_the_picture(tmp_path):
     case3 = regions[(regions.L01 == 11.5) & (regions.L02 == 11.5)]
     assert int(case3.stable.iloc[0]) == len(cb.solve(P).stable)
     assert (folder / "map.png").is_file() and (folder / "run.json").is_file()
+    cert = json.loads((folder / "run.json").read_text())["certificate"]
+    assert cert["status"] == "proved" and cert["statement"].startswith("proved: the parallel")
+    assert cert["leaves"] > 1000 and cert["edge_crossings"] > 1000
+    assert "python-flint" in cert["library"]
+
+
+def test_no_physical_fold_point_has_a_zero_length_spring(folds):
+    """Issue 16 item 15: where a fold curve runs into a zero-length configuration of a spring
+    (V not smooth there) it ends: kind zero_length, not physical, by the solutions' rule. The
+    paper geometry's spring 2 has two (the case 3 rows of reason zero_length_spring)."""
+    threshold = Tolerances().zero_length * P.L3
+    phys = folds[folds.physical]
+    assert (phys[["d1", "d2"]].to_numpy() >= threshold).all()
+    assert set(phys.kind) <= {"fold", "cusp"}
+    ends = folds[folds.kind == "zero_length"]
+    assert not ends.physical.any() and (ends[["d1", "d2"]].min(axis=1) < threshold).all()
+    zero = solve_point(P).table
+    zero = zero[(zero.reason == "zero_length_spring") & zero.is_real & (zero.d1.abs() > 1)]
+    for _, row in zero.drop_duplicates(["gamma1_deg", "gamma2_deg"]).iterrows():
+        pose = ends[["gamma1_deg", "gamma2_deg"]].to_numpy(float)
+        gap = np.abs((pose - [row.gamma1_deg, row.gamma2_deg] + 180) % 360 - 180).max(axis=1)
+        assert gap.min() < 0.01, (row.gamma1_deg, row.gamma2_deg)
+    # The end the map reported as a cusp (L01 = 10.9677, L02 = 5.7659, gamma 122.9, 46.3 deg).
+    near = ends[(ends.L01 - 10.9677).abs().lt(1e-3) & (ends.L02 - 5.7659).abs().lt(1e-3)]
+    assert len(near) == 1 and abs(near.gamma1_deg.iloc[0] - 122.9053) < 1e-3
 
 
 def test_cusps_are_degenerate_folds(folds):

@@ -4,8 +4,12 @@
    (`certify_roots`): a unique solution in a small box, real where the table says real.
 2. Each physical equilibrium: Krawczyk on grad V = 0 in the angles (a tiny box), and its kind
    from the interval Hessian over that box (positive definite: a minimum, stable).
-3. The torus, by branch and bound (`certify_torus`): every critical point of V whose spring
-   lengths exceed the reported bound lies in one of the boxes of step 2.
+3. Completeness (`certify_search`): every critical point of V whose spring lengths exceed the
+   reported bound is relaxed (both springs at their free lengths: a branch and bound on that
+   polynomial system) or lies on the parallel curve a_1 x a_2 = 0 (enclosed by `certify_curve`,
+   then searched along in one variable); each lies in one of the boxes of step 2.
+   `method="torus"` runs the earlier two-dimensional branch and bound over the torus instead
+   (`certify_torus`, slower; an independent route for the tests).
 Any difference from the table -- a critical point it lacks, a physical row not proved, a kind
 that differs -- is a contradiction: the certificate says so and the caller raises.
 """
@@ -20,11 +24,20 @@ import numpy as np
 
 from ..params import Params
 from .certify_roots import certify_rows
+from .certify_search import Known, search
 from .certify_torus import arb_params, box, branch_and_bound, enclosures, krawczyk_2d
 
 SHORT = 1e-3  # springs shorter than this (times L3) are set aside: V is not smooth at length 0
 MIN_WIDTH = 1e-4  # radians: the smallest box away from a known equilibrium
 ROOT_BOX = 1e-7  # radians: the half-width of the box proving each equilibrium
+METHODS = {
+    "curve": "Krawczyk (complex balls) per solution; completeness: the relaxed equilibria by "
+    "branch and bound with Krawczyk on d_i^2 = L0_i^2, the others along the parallel curve "
+    "a1 x a2 = 0 (a ball-arithmetic cover of the curve, then bisection in one angle with "
+    "Krawczyk on grad V)",
+    "torus": "Krawczyk (complex balls) per solution; branch and bound with Krawczyk on grad V "
+    "over the torus",
+}
 
 
 @dataclass(frozen=True)
@@ -43,6 +56,8 @@ class Certificate:
     undecided_boxes: list[tuple]
     contradictions: list[str] = field(default_factory=list)
     seconds: float = 0.0
+    timings: dict[str, float] = field(default_factory=dict)  # rows, equilibria, completeness
+    method: str = "curve"
 
     def record(self) -> dict:
         """The run.json `certificate` block."""
@@ -51,8 +66,7 @@ class Certificate:
         return {
             "status": self.status,
             "statement": self.statement,
-            "method": "Krawczyk (complex balls) per solution; branch and bound with Krawczyk "
-            "on grad V over the torus",
+            "method": METHODS[self.method],
             "library": f"python-flint {dist_version('python-flint', 'flint')} (arb/acb)",
             "rows_certified": int(self.certified.sum()),
             "proved_equilibria": self.proved_equilibria,
@@ -63,6 +77,7 @@ class Certificate:
             "undecided_boxes": [[float(v) for v in q] for q in self.undecided_boxes],
             "contradictions": self.contradictions,
             "seconds": self.seconds,
+            "timings": self.timings,
         }
 
 
@@ -80,41 +95,49 @@ def _kind(params: Params, pa, g: tuple[float, float]) -> str:
     return "undecided"
 
 
-def _equilibria(params: Params, table) -> tuple[dict, dict, list[str]]:
-    """Each physical row proved in a tiny box: (enclosures by row, kinds by solution_id,
-    rows not proved)."""
+def _equilibria(params: Params, table) -> tuple[list[Known], dict, list[int]]:
+    """Each physical row proved in a tiny box: (the proved ones, kinds by solution_id, rows
+    not proved)."""
     pa = arb_params(params)
-    known, kinds, failed = {}, {}, []
+    known, kinds, failed = [], {}, []
     phys = np.flatnonzero(np.asarray(table["physical"], dtype=bool))
     for row in phys:
         g1 = math.radians(float(table["gamma1_deg"][row]))
         g2 = math.radians(float(table["gamma2_deg"][row]))
-        g = (g1, g2)
         q = (g1 - ROOT_BOX, g1 + ROOT_BOX, g2 - ROOT_BOX, g2 + ROOT_BOX)
         verdict, enclosure = krawczyk_2d(params, pa, q)
         sid = int(table["solution_id"][row])
         if verdict == "one":
-            known[sid] = enclosure
-            kinds[sid] = _kind(params, pa, g)
+            bounds = []
+            for e in enclosure:
+                bounds += [math.nextafter(float(e.lower()), -math.inf),
+                           math.nextafter(float(e.upper()), math.inf)]  # fmt: skip
+            known.append(Known(sid, q, tuple(bounds)))
+            kinds[sid] = _kind(params, pa, (g1, g2))
         else:
             failed.append(sid)
     return known, kinds, failed
 
 
 def certify_table(
-    params: Params, table, short: float = SHORT, min_width: float = MIN_WIDTH
-) -> Certificate:
+    params: Params, table, short: float = SHORT, min_width: float = MIN_WIDTH,
+    method: str = "curve",
+) -> Certificate:  # fmt: skip
     """Prove each row of a solutions table and the completeness of its physical rows."""
     start = time.perf_counter()
     certified, radius = certify_rows(params, table)
+    t_rows = time.perf_counter()
     known, kinds, unproved = _equilibria(params, table)
-    proof = branch_and_bound(params, known, short * params.L3, min_width)
+    t_known = time.perf_counter()
+    proof = _completeness(params, known, short * params.L3, min_width, method)
+    t_done = time.perf_counter()
     bound = proof.longest_excluded
     contradictions = [
         f"a critical point of V in gamma1 {math.degrees(q[0]):.6f}..{math.degrees(q[1]):.6f}, "
         f"gamma2 {math.degrees(q[2]):.6f}..{math.degrees(q[3]):.6f} deg is not in the table"
         for q in proof.missing
     ]
+    contradictions += _duplicates(known)
     found = {sid for sid, boxes in proof.roots.items() if boxes}
     contradictions += _unmatched_rows(params, table, found | set(), unproved, bound)
     contradictions += _kind_differences(table, kinds)
@@ -123,10 +146,47 @@ def certify_table(
     undecided = bool(proof.undecided) or open_rows > 0 or "undecided" in kinds.values()
     status = "contradiction" if contradictions else "undecided" if undecided else "proved"
     statement = _statement(len(found), bound, certified, singular, status, proof, open_rows)
+    timings = {"rows": t_rows - start, "equilibria": t_known - t_rows,
+               "completeness": t_done - t_known}  # fmt: skip
     return Certificate(
         status, statement, certified, radius, len(found), kinds, bound, proof.boxes,
         len(proof.excluded), proof.undecided, contradictions, time.perf_counter() - start,
+        timings, method,
     )  # fmt: skip
+
+
+def _completeness(params: Params, known: list[Known], short: float, min_width: float,
+                  method: str):  # fmt: skip
+    """The search for critical points outside the known equilibria's boxes (`method`: 'curve',
+    along the parallel curve, or 'torus', the two-dimensional branch and bound)."""
+    if method == "curve":
+        return search(params, known, short, min_width)
+    if method != "torus":
+        raise ValueError(f"method {method!r}: 'curve' or 'torus'")
+    from .certify_curve import interval
+
+    balls = {k.sid: (interval(*k.enclosure[:2]), interval(*k.enclosure[2:])) for k in known}
+    return branch_and_bound(params, balls, short, min_width)
+
+
+def _duplicates(known: list[Known]) -> list[str]:
+    """Two rows proved in overlapping enclosures may be one equilibrium: a contradiction."""
+
+    def centre_half(k: Known, j: int) -> tuple[float, float]:
+        lo, hi = k.enclosure[2 * j], k.enclosure[2 * j + 1]
+        return 0.5 * (lo + hi), 0.5 * (hi - lo)
+
+    out = []
+    for n, a in enumerate(known):
+        for b in known[n + 1 :]:
+            overlap = True
+            for j in (0, 1):
+                (ca, ha), (cb, hb) = centre_half(a, j), centre_half(b, j)
+                overlap &= abs((ca - cb + math.pi) % (2 * math.pi) - math.pi) <= ha + hb
+            if overlap:
+                out.append(f"solutions {a.sid} and {b.sid} are proved in overlapping boxes: "
+                           "they may be one equilibrium")  # fmt: skip
+    return out
 
 
 def _unmatched_rows(params, table, found: set, unproved: list, bound: float) -> list[str]:

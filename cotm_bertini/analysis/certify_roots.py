@@ -24,10 +24,13 @@ WORKING_BITS = 128  # the centre is polished by Newton at this precision first
 
 @dataclass(frozen=True)
 class BallSystem:
-    """A polynomial system with ball coefficients: per function, (coefficient, exponents)."""
+    """A polynomial system with ball coefficients. `terms`: per function, (coefficient,
+    ((variable, exponent), ...)) with the zero exponents left out; `derivatives`: per function
+    and variable, the terms of the partial derivative in the same form."""
 
     variables: tuple[str, ...]
-    terms: tuple[tuple[tuple[object, tuple[int, ...]], ...], ...]
+    terms: tuple[tuple[tuple[object, tuple[tuple[int, int], ...]], ...], ...]
+    derivatives: tuple[tuple[tuple, ...], ...]
     top: int
 
 
@@ -46,60 +49,58 @@ def ball_system(params: Params) -> BallSystem:
             ball = arb(float(coef))
             for name, e in zip(ps.parameters, pexps, strict=True):
                 ball = ball * values[name] ** int(e) if e else ball
-            function.append((ball, tuple(int(v) for v in exps)))
+            function.append((ball, tuple((v, int(e)) for v, e in enumerate(exps) if e)))
         terms.append(tuple(function))
-    top = max(max(e) for f in terms for _, e in f)
-    return BallSystem(ps.variables, tuple(terms), top)
+    n = len(ps.variables)
+    derivatives = tuple(tuple(_derivative(f, j) for j in range(n)) for f in terms)
+    top = max((e for f in terms for _, pw in f for _, e in pw), default=1)
+    return BallSystem(ps.variables, tuple(terms), derivatives, top)
+
+
+def _derivative(function: tuple, j: int) -> tuple:
+    """The terms of d function / d x_j."""
+    out = []
+    for coef, powers in function:
+        for v, e in powers:
+            if v == j:
+                rest = tuple((w, f - 1 if w == j else f) for w, f in powers if w != j or f > 1)
+                out.append((coef * e, rest))
+    return tuple(out)
 
 
 def _powers(x: list, top: int) -> list[list]:
     out = []
     for v in x:
-        row = [v**0]
-        for _ in range(top):
+        row = [v**0, v]
+        for _ in range(top - 1):
             row.append(row[-1] * v)
         out.append(row)
     return out
 
 
+def _sum(terms: tuple, pw: list, zero):
+    total = zero
+    for coef, powers in terms:
+        term = coef
+        for v, e in powers:
+            term = term * pw[v][e]
+        total = total + term
+    return total
+
+
 def evaluate(system: BallSystem, x: list) -> list:
     """F at a vector of acb balls."""
-    pw = _powers(x, system.top)
-    out = []
-    for function in system.terms:
-        total = x[0] * 0
-        for coef, exps in function:
-            term = coef
-            for v, e in enumerate(exps):
-                if e:
-                    term = term * pw[v][e]
-            total = total + term
-        out.append(total)
-    return out
+    pw, zero = _powers(x, system.top), x[0] * 0
+    return [_sum(function, pw, zero) for function in system.terms]
 
 
 def jacobian(system: BallSystem, x: list) -> list[list]:
     """The Jacobian at (over) a vector of acb balls."""
-    pw = _powers(x, system.top)
-    n = len(x)
-    out = []
-    for function in system.terms:
-        row = [x[0] * 0 for _ in range(n)]
-        for coef, exps in function:
-            for j, ej in enumerate(exps):
-                if not ej:
-                    continue
-                term = coef * ej
-                for v, e in enumerate(exps):
-                    power = e - 1 if v == j else e
-                    if power:
-                        term = term * pw[v][power]
-                row[j] = row[j] + term
-        out.append(row)
-    return out
+    pw, zero = _powers(x, system.top), x[0] * 0
+    return [[_sum(d, pw, zero) for d in row] for row in system.derivatives]
 
 
-def polish(system: BallSystem, y: np.ndarray, c: np.ndarray, steps: int = 3) -> list:
+def polish(system: BallSystem, y: np.ndarray, c: np.ndarray, steps: int = 1) -> list:
     """The centre refined by Newton steps x - Y F(x) in ball arithmetic (at the working
     precision), as acb midpoints: an ill-conditioned root is located far better than in double
     precision, which the Krawczyk box needs. The steps need not be rigorous: only the test is."""
@@ -114,45 +115,88 @@ def polish(system: BallSystem, y: np.ndarray, c: np.ndarray, steps: int = 3) -> 
     return x
 
 
-def krawczyk(system: BallSystem, jac_mid: np.ndarray, c: np.ndarray, r: float) -> bool:
-    """Whether the box of half-width r around c (complex) holds exactly one solution."""
-    from flint import acb, acb_mat, arb
+@dataclass(frozen=True)
+class _Centre:
+    """A reported point prepared for the Krawczyk test: the polished centre (acb), the
+    preconditioner Y (acb_mat) and F at the centre (acb_mat)."""
 
-    if not np.isfinite(jac_mid).all() or abs(np.linalg.det(jac_mid)) < 1e-300:
-        return False
-    y = np.linalg.inv(jac_mid)
-    n = len(c)
-    centre = polish(system, y, c)
+    centre: list
+    ym: object
+    fc: object
+
+
+def prepare(system: BallSystem, y: np.ndarray, c: np.ndarray, near: np.ndarray,
+            steps: int) -> object:  # fmt: skip
+    """The centre for the tests around the reported point c: `near` (a double-precision Newton
+    refinement of c) after `steps` Newton steps in ball arithmetic, with Y the inverse of the
+    Jacobian there; None if the root is further than 1e-6 (relative) from c: the reported
+    point is not that root to the digits it claims."""
+    from flint import acb, acb_mat
+
+    centre = polish(system, y, near, steps) if steps else [acb(complex(z)) for z in near]
     moved = max(abs(complex(z.mid()) - complex(w)) for z, w in zip(centre, c, strict=True))
     if moved > 1e-6 * (1 + float(np.abs(c).max())):
-        return False  # the reported point is not that root to the digits it claims
-    real = not np.any(np.imag(c))
-    if real:  # keep a real centre real: the box must be its own conjugate
+        return None
+    if not np.any(np.imag(c)):  # keep a real centre real: the box must be its own conjugate
         centre = [acb(z.real.mid()) for z in centre]
+    n = len(c)
+    ym = acb_mat([[acb(complex(y[i, j])) for j in range(n)] for i in range(n)])
+    return _Centre(centre, ym, acb_mat([[f] for f in evaluate(system, centre)]))
+
+
+def krawczyk(system: BallSystem, prepared: _Centre, r: float) -> bool:
+    """Whether the box of half-width r around the prepared centre holds exactly one solution:
+    K(X) = c - Y F(c) + (I - Y J(X)) (X - c) inside the interior of X."""
+    from flint import acb, acb_mat, arb
+
+    centre, n = prepared.centre, len(prepared.centre)
     box = [acb(arb(z.real.mid(), r), arb(z.imag.mid(), r)) for z in centre]
-    ym = acb_mat([[acb(float(y[i, j].real), float(y[i, j].imag)) for j in range(n)]
-                  for i in range(n)])  # fmt: skip
-    fc = acb_mat([[f] for f in evaluate(system, centre)])
     jx = acb_mat(jacobian(system, box))
     ident = acb_mat([[1 if i == j else 0 for j in range(n)] for i in range(n)])
     diff = acb_mat([[box[i] - centre[i]] for i in range(n)])
-    k = acb_mat([[z] for z in centre]) - ym * fc + (ident - ym * jx) * diff
+    ym = prepared.ym
+    k = acb_mat([[z] for z in centre]) - ym * prepared.fc + (ident - ym * jx) * diff
     return all(box[i].contains_interior(k[i, 0]) for i in range(n))
+
+
+def _newton(numeric, points: np.ndarray, steps: int = 3) -> np.ndarray:
+    """Double-precision Newton steps from every point at once (kept where they do not reduce
+    the residual): a good start for the polish."""
+    x = points.copy()
+    for _ in range(steps):
+        f = numeric.evaluate(x)
+        jac = numeric.jacobian(x)
+        ok = np.isfinite(jac).all(axis=(1, 2)) & (np.abs(np.linalg.det(jac)) > 1e-300)
+        if not ok.any():
+            break
+        new = x.copy()
+        new[ok] = x[ok] - np.linalg.solve(jac[ok], f[ok][..., None])[..., 0]
+        better = np.abs(numeric.evaluate(new)).max(axis=1) < np.abs(f).max(axis=1)
+        x = np.where(better[:, None], new, x)
+    return x
 
 
 def certify_rows(params: Params, table) -> tuple[np.ndarray, np.ndarray]:
     """For each row of a solutions table: (proved, box half-width in normalised units or NaN).
 
     A real row is proved real (a box centred on the real space); a complex one proved non-real.
-    Singular rows (double roots) cannot pass: the Jacobian is singular there.
+    Rows the table marks singular (double roots) are not tried: the Jacobian is singular there.
     """
     variables = parametric_system(params.zfl).variables
     numeric = polynomial_system(params.normalized())
     scale = np.array([params.L3 if v.startswith("d") else 1.0 for v in variables])
     re = np.column_stack([np.asarray(table[f"{v}_re"], float) for v in variables])
     im = np.column_stack([np.asarray(table[f"{v}_im"], float) for v in variables])
-    points = (re + 1j * im) / scale
     real = np.asarray(table["is_real"], dtype=bool)
+    points = np.where(real[:, None], re + 0j, re + 1j * im) / scale
+    todo = np.flatnonzero(~np.asarray(table["singular"], dtype=bool))
+    near = _newton(numeric, points[todo]) if len(todo) else points[todo]
+    near[real[todo]] = near[real[todo]].real
+    n = len(variables)
+    jacs = numeric.jacobian(near) if len(todo) else np.zeros((0, n, n))
+    invertible = np.isfinite(jacs).all(axis=(1, 2)) & (np.abs(np.linalg.det(jacs)) > 1e-300)
+    inverses = np.zeros_like(jacs)
+    inverses[invertible] = np.linalg.inv(jacs[invertible])
     proved = np.zeros(len(points), dtype=bool)
     radius = np.full(len(points), np.nan)
     from flint import ctx
@@ -160,16 +204,24 @@ def certify_rows(params: Params, table) -> tuple[np.ndarray, np.ndarray]:
     bits, ctx.prec = ctx.prec, WORKING_BITS
     try:
         system = ball_system(params)
-        for i, c in enumerate(points):
-            c = c.real + 0j if real[i] else c
-            jac = numeric.jacobian(c[None, :])[0]
-            for rel in RADII:
-                r = rel * (1 + float(np.abs(c).max()))
-                if not real[i] and (np.abs(c.imag) <= r).all():
-                    continue  # this box would reach the real space: no proof of non-realness
-                if krawczyk(system, jac, c, r):
-                    proved[i], radius[i] = True, r
-                    break
+        for row, start, y, ok in zip(todo, near, inverses, invertible, strict=True):
+            if ok:
+                proved[row], radius[row] = _prove(system, points[row], start, y, real[row])
     finally:
         ctx.prec = bits
     return proved, radius
+
+
+def _prove(system: BallSystem, c: np.ndarray, start: np.ndarray, y: np.ndarray,
+           real: bool) -> tuple[bool, float]:  # fmt: skip
+    """(proved, box half-width) for one row: the double-precision centre first, then one
+    Newton step in ball arithmetic with each radius in turn (an ill-conditioned root)."""
+    scale = 1 + float(np.abs(c).max())
+    for steps, radii in ((0, RADII[:1]), (1, RADII)):
+        prepared = prepare(system, y, c, start, steps)
+        for r in (rel * scale for rel in (radii if prepared is not None else ())):
+            if not real and (np.abs(c.imag) <= r).all():
+                continue  # this box would reach the real space: no proof of non-realness
+            if krawczyk(system, prepared, r):
+                return True, r
+    return False, float("nan")

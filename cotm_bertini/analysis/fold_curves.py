@@ -107,7 +107,21 @@ def fold_curves(params: Params, points: int = 1500) -> pd.DataFrame:
     """Every fold point carried by the samples of the parallel curve (free lengths of any sign;
     `physical`: both >= 0), in m and degrees, and the cusps found along it; the geometry's own
     L01, L02 are not used."""
-    samples = parallel_samples(params, points)
+    return _folds(params, parallel_samples(params, points), points)
+
+
+def fold_curves_proved(params: Params, points: int = 1500) -> tuple[pd.DataFrame, dict]:
+    """`fold_curves` from samples proved to leave no part of the parallel curve out
+    (`certify_curve.certify_samples`: crossings the sampler missed are added), and the
+    certificate (the run.json `certificate` record of the map)."""
+    from .certify_curve import certify_samples
+
+    record, samples = certify_samples(params, parallel_samples(params, points), _grid(points))
+    return _folds(params, samples, points), record
+
+
+def _folds(params: Params, samples: list, points: int) -> pd.DataFrame:
+    """The fold and cusp table of the parallel curve's samples."""
     g1, g2 = _poses(samples)
     terms = _line_terms(params, g1, g2)
     c1, c2 = terms[4], terms[5]
@@ -117,7 +131,23 @@ def fold_curves(params: Params, points: int = 1500) -> pd.DataFrame:
             rows.append(_fold_row(terms, n, t, g1[n], g2[n]))
     table = _table(rows)
     table = table.assign(curve_id=link_curves(table, params.L3))
-    return pd.concat([table, _cusps(params, samples, _grid(points))], ignore_index=True)
+    table = pd.concat([table, _cusps(params, samples, _grid(points))], ignore_index=True)
+    return zero_length_ends(table, params.L3)
+
+
+def zero_length_ends(table: pd.DataFrame, length_unit: float) -> pd.DataFrame:
+    """Rows where a spring is shorter than the solutions' zero-length rule (Tolerances
+    .zero_length times L3) get kind `zero_length` and are not physical: V is not smooth there
+    (a spring with a free length at zero length), so a fold curve running into that point ends
+    there; it neither folds nor turns back in a cusp."""
+    from ..settings import Tolerances
+
+    lengths = table[["d1", "d2"]].to_numpy(float)
+    short = (lengths < Tolerances().zero_length * length_unit).any(axis=1)
+    return table.assign(
+        kind=np.where(short, "zero_length", table.kind),
+        physical=table.physical.to_numpy(bool) & ~short,
+    )
 
 
 def link_curves(folds: pd.DataFrame, length_scale: float) -> np.ndarray:

@@ -75,13 +75,13 @@ def design_map(
 ) -> DesignMap:
     """Fold curves in the window, and the number of physical and stable equilibria on a
     points x points grid of it (by a 2-D sweep: parameter homotopies)."""
-    from ..analysis.fold_curves import fold_curves
+    from ..analysis.fold_curves import fold_curves_proved
     from .sweeps import sweep
 
     _window("L01", *l01, points)
     _window("L02", *l02, points)
     t0 = time.perf_counter()
-    folds = fold_curves(params)
+    folds, certificate = fold_curves_proved(params)
     t_folds = time.perf_counter() - t0
     inside = folds.physical & folds.L01.between(*l01) & folds.L02.between(*l02)
     folds = folds[inside].reset_index(drop=True)
@@ -93,7 +93,7 @@ def design_map(
     record = {
         "params": params.as_dict(), "window": {"L01": list(l01), "L02": list(l02)},
         "points": points, "fold_points": len(folds), "fold_curves": pieces,
-        "cusps": int((folds.kind == "cusp").sum()),
+        "cusps": int((folds.kind == "cusp").sum()), "certificate": certificate,
         "timings": {"folds": t_folds, "regions": time.perf_counter() - t0 - t_folds},
         "sweep_folder": str(sw.folder), "sweep_status": sw.status, "command": sys.argv[:],
     }  # fmt: skip

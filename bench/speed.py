@@ -12,9 +12,14 @@
 3. One solve end to end: `cotm-bertini solve case3 --no-cache --no-plots` as a subprocess,
    median of 5, with the import times of its heavy modules (python -X importtime).
 4. `--profile`: cProfile of continued sweep points (the top functions).
+5. `--ratios`: issue 17's yardstick, in one run: the CLI sweep of the paper (241 points, 2
+   workers, no figures) and the cold `solve case3 --no-cache --no-plots`, each interleaved with a
+   bare `bertini2` case-2 solve (total degree, 48 paths), median of `--repeats`; the sweep's time
+   split into solving (run.json stats.seconds: worker start-up and the points), finishing
+   (branches, events, CSV) and the rest (interpreter, imports, exit); the load average beside.
 
 Benchmarks, not tests: nothing is asserted; targets are printed beside the measurements.
-Usage: .venv/bin/python bench/speed.py [--grid] [--profile] [--sample 8]
+Usage: .venv/bin/python bench/speed.py [--grid] [--profile] [--sample 8] [--ratios [--repeats 5]]
 """
 
 from __future__ import annotations
@@ -34,6 +39,9 @@ SERIES = (1, 10, 30, 100, 241)
 TARGET_SWEEP_S = 2.5
 TARGET_GRID_S = 120.0
 TARGET_SOLVE_S = 0.3
+TARGET_SWEEP_RATIO = 1.6  # issue 17: the CLI sweep in <= 1.6 bare bertini2 case-2 solves
+TARGET_OUTSIDE = 0.2  # ... with at most 20 % of it outside solving
+TARGET_SOLVE_RATIO = 0.3  # the cold solve in <= 0.3 bare bertini2 case-2 solves
 
 
 def sweep_values(n: int) -> np.ndarray:
@@ -295,12 +303,96 @@ def profile_points(n: int = 101) -> None:
     pstats.Stats(prof).sort_stats("tottime").print_stats(15)
 
 
+def _bare_case2() -> float:
+    """One bare bertini2 solve of case 2's total-degree input: its wall seconds."""
+    from cotm_bertini.backends.render import render_input
+    from cotm_bertini.model.compiled import polynomial_system
+    from cotm_bertini.params import Params
+    from cotm_bertini.settings import Settings
+
+    params = Params.case("case2")
+    text = render_input(polynomial_system(params), Settings(seed=1, engine="cli"),
+                        params.as_dict())  # fmt: skip
+    with tempfile.TemporaryDirectory(prefix="bench-bare-") as tmp:
+        return run_bertini2(text, Path(tmp) / "run")
+
+
+def _timed_cli(args: list[str]) -> float:
+    exe = str(Path(sys.executable).with_name("cotm-bertini"))
+    start = time.perf_counter()
+    subprocess.run([exe, *args], capture_output=True, check=True)
+    return time.perf_counter() - start
+
+
+def _cli_sweep() -> dict:
+    """The CLI sweep of the paper in a new folder: wall, solving and finishing seconds."""
+    import json
+
+    with tempfile.TemporaryDirectory(prefix="bench-sweep-") as tmp:
+        wall = _timed_cli(["sweep", "--param", "L01", "--from", "0", "--to", "12",
+                           "--points", "241", "--workers", "2", "--no-plots", "--quiet",
+                           "--out", tmp])  # fmt: skip
+        record = json.loads(next(Path(tmp).glob("sweep-*/run.json")).read_text())
+    return {"wall": wall, "solve": record["timings"]["solve"],
+            "finish": record["timings"]["finish"]}  # fmt: skip
+
+
+def _list(values: list[float]) -> str:
+    return ", ".join(f"{v:.2f}" for v in values)
+
+
+def ratios(repeats: int = 5) -> dict:
+    """Section 5: the CLI sweep and the cold solve against bare bertini2 case-2 solves, each
+    pair run back to back, so that both see the same load."""
+    import os
+
+    solve = ["solve", "case3", "--no-cache", "--no-plots", "--quiet"]
+    with tempfile.TemporaryDirectory(prefix="bench-solve-") as tmp:
+        _timed_cli([*solve, "--out", tmp])  # warm: generic sets, compiled equations
+        _cli_sweep()
+        load = [os.getloadavg()[0]]
+        bare, sweeps, solves = [], [], []
+        for _ in range(repeats):
+            bare.append(_bare_case2())
+            sweeps.append(_cli_sweep())
+            bare.append(_bare_case2())
+            solves.append(_timed_cli([*solve, "--out", tmp]))
+        load.append(os.getloadavg()[0])
+    b = median(bare)
+    wall = median([s["wall"] for s in sweeps])
+    solving = median([s["solve"] for s in sweeps])
+    finishing = median([s["finish"] for s in sweeps])
+    out = {
+        "bare bertini2 case 2 (s, median)": b,
+        "CLI sweep, 241 points (s)": wall,
+        "  of which solving (stats.seconds)": solving,
+        "  of which finishing (branches, events, CSV)": finishing,
+        "  of which start-up, imports, exit": wall - solving - finishing,
+        "sweep / bare case 2": wall / b,
+        "sweep: share outside solving": 1 - solving / wall,
+        "cold solve case3 (s)": median(solves),
+        "cold solve / bare case 2": median(solves) / b,
+        "load average (1 min) before, after": f"{load[0]:.2f}, {load[1]:.2f}",
+        "runs": f"sweeps {_list([s['wall'] for s in sweeps])}; solves {_list(solves)}; "
+        f"bare {_list(bare)}",
+    }
+    show(f"5. Same-run ratios (targets: sweep <= {TARGET_SWEEP_RATIO} bare case-2 solves, "
+         f"<= {TARGET_OUTSIDE:.0%} outside solving; cold solve <= {TARGET_SOLVE_RATIO})",
+         pd.DataFrame([out]).T.reset_index().set_axis(["what", "value"], axis=1))  # fmt: skip
+    return out
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--grid", action="store_true", help="also the 101 x 101 grid (~2 min)")
     ap.add_argument("--profile", action="store_true", help="also a profile of sweep points")
     ap.add_argument("--sample", type=int, default=8, help="points timed for the peers")
+    ap.add_argument("--ratios", action="store_true", help="only section 5 (issue 17 ratios)")
+    ap.add_argument("--repeats", type=int, default=5, help="repeats of section 5")
     args = ap.parse_args()
+    if args.ratios:
+        ratios(args.repeats)
+        return
     table = series(args.sample)
     show("1. The paper's sweep by four routes (2 cores)", table.drop(columns=["methods"]),
          {"seconds": ".3g", "ms_per_point": ".3g", "us_per_path": ".0f",

@@ -22,19 +22,44 @@ NEWTON = "Newton from the neighbouring point (complete)"
 SEGMENT = "continued from the neighbouring point"
 
 
-@pytest.mark.parametrize(("step", "method"), [(0.05, NEWTON), (1.0, SEGMENT)])
-def test_continued_point_equals_the_generic_route(step, method):
+@pytest.mark.parametrize(
+    ("step", "method", "newton"), [(0.05, NEWTON, True), (1.0, NEWTON, True), (1.0, SEGMENT, False)]
+)
+def test_continued_point_equals_the_generic_route(step, method, newton, monkeypatch):
     """From L01 = 10.9 to 10.9 + step: Newton for a short step; across the fold at 11.0128 (step
-    1) Newton cannot find every root (a pair is born there) and the segment homotopy does. Both
-    equal an ab-initio total-degree solve by the bertini2 command."""
+    1, where a pair of real roots is born) Newton along a detour through complex L01, or (Newton
+    off) the segment homotopy. Each equals an ab-initio total-degree solve by the bertini2
+    command."""
     a = solve_point(Params(L01=10.9))
     assert a.warm is not None
+    if not newton:
+        monkeypatch.setattr(target, "newton_continue", lambda *a: (None, "off for this test"))
     b = solve_point(Params(L01=10.9 + step), warm=a.warm)
     assert b.details["homotopy"]["method"] == method
     fresh = solve_point(Params(L01=10.9 + step), Settings(engine="cli"))
     assert len(b.table) == len(fresh.table)
     assert np.abs(_angles(b.table) - _angles(fresh.table)).max() < 1e-6
     assert b.counts["stable"] == fresh.counts["stable"]
+
+
+def test_newton_starts_a_line_of_points_from_the_secant():
+    """Points on a line: the third is started from the secant through the first two (closer
+    than the second point's roots are), and what Newton finds from there is still checked."""
+    from cotm_bertini.backends.homotopy import generic_set
+    from cotm_bertini.model.compiled import parametric_system
+
+    a = solve_point(Params(L01=5.0))
+    b = solve_point(Params(L01=5.1), warm=a.warm)
+    assert b.warm.before is not None and b.warm.before[0] == a.warm.params
+    guess = neighbour._secant(b.warm, Params(L01=5.2))
+    c = solve_point(Params(L01=5.2), warm=b.warm)
+    assert c.details["homotopy"]["method"] == NEWTON
+    mine = c.warm.points
+    assert np.abs(guess - mine).max() < np.abs(b.warm.points - mine).max()
+    assert neighbour._secant(b.warm, Params(L01=5.1, k1=3.0)) is None  # off the line
+    ps = parametric_system((False, True))
+    result, why = neighbour.newton_continue(ps, generic_set(ps, 1), b.warm, Params(L01=5.2))
+    assert why == "" and len(result[0]) == len(mine)
 
 
 def test_newton_refuses_a_set_it_cannot_prove_complete():

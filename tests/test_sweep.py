@@ -16,6 +16,7 @@ from conftest import solve
 
 from cotm_bertini.continuation.runner import assemble, prepare, run_points
 from cotm_bertini.continuation.spec import SweepSpec
+from cotm_bertini.continuation.store import stored_indices
 from cotm_bertini.params import TABLE1, Params, make_params
 from cotm_bertini.settings import Settings
 
@@ -111,16 +112,18 @@ def test_resume_after_kill_9(tmp_path):
     ]
     proc = _cli(*args, "--out", str(tmp_path / "a"))
     deadline = time.time() + 120
-    points = []
+    points: set[int] = set()
     while time.time() < deadline:
-        points = list((tmp_path / "a").glob("sweep-*/points/*.csv"))
+        folders = list((tmp_path / "a").glob("sweep-*"))
+        points = stored_indices(folders[0]) if folders else set()
         if len(points) >= 5:
             break
         time.sleep(0.05)
     os.killpg(proc.pid, signal.SIGKILL)
     proc.wait()
-    assert 5 <= len(points) < 31, "the kill should land mid-sweep"
     folder = next((tmp_path / "a").glob("sweep-*"))
+    stored = stored_indices(folder)
+    assert 5 <= len(points) <= len(stored) < 31, "the kill should land mid-sweep"
     assert not (folder / "sweep.csv").exists()
     again = _cli(*args, "--out", str(tmp_path / "a"))
     out, err = again.communicate(timeout=300)

@@ -15,10 +15,11 @@ from ..settings import Settings
 class Sweep:
     """A finished sweep: `table` (sweep.csv), `events` (events.csv), `record` (run.json)."""
 
-    def __init__(self, spec, folder: Path, record: dict):
+    def __init__(self, spec, folder: Path, record: dict, columns: dict | None = None):
         self.spec = spec
         self.folder = Path(folder)
         self.record = record
+        self._columns = columns  # the table as numpy columns, when the sweep was just finished
         self._table = None
         self._events = None
 
@@ -32,6 +33,10 @@ class Sweep:
     @property
     def table(self):
         """One row per finite solution per point (pandas DataFrame, the sweep.csv columns)."""
+        if self._table is None and self._columns is not None:
+            from ..continuation.tables import to_frame
+
+            self._table, self._columns = to_frame(self._columns), None
         if self._table is None:
             from ..analysis.classify import read_table
 
@@ -65,9 +70,11 @@ class Sweep:
         if one_d:
             from ..plot.bifurcation import plot_bifurcation
 
+            fixed = {k: v for k, v in self.spec.base.items() if k != self.spec.param}
             written = plot_bifurcation(
-                self.table, self.spec.param, path, show_all=show_all, events=self.events
-            )
+                self.table, self.spec.param, path, show_all=show_all, events=self.events,
+                fixed=fixed,
+            )  # fmt: skip
         else:
             from ..plot.counts import plot_sweep_counts
 
@@ -119,17 +126,21 @@ def sweep(
 
 def _run(spec, folder: Path, workers: int, scheduler, progress, command) -> Sweep:
     """Solve a prepared sweep folder's pending points and finish it."""
-    from ..continuation.results import finish
+    from ..continuation.results import finish_columns
     from ..continuation.runner import pending_points, run_points
+    from ..continuation.store import PointStore
 
-    bar, callback = _progress(progress, spec.size(), len(pending_points(spec, folder)))
+    store = PointStore(folder)  # the points stored so far, then every point, in memory
+    bar, callback = _progress(progress, spec.size(), len(pending_points(spec, folder, store)))
     try:
-        stats = run_points(spec, folder, workers=workers, scheduler=scheduler, progress=callback)
+        stats = run_points(
+            spec, folder, workers=workers, scheduler=scheduler, progress=callback, store=store
+        )
     finally:
         if bar is not None:
             bar.close()
-    record = finish(spec, folder, stats, workers=workers, scheduler=scheduler, command=command)
-    return Sweep(spec, folder, record)
+    record, columns = finish_columns(spec, folder, stats, workers, scheduler, command, store)
+    return Sweep(spec, folder, record, columns)
 
 
 def resume_sweep(

@@ -10,6 +10,7 @@ caller solves the point from the generic set instead.
 from __future__ import annotations
 
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -37,11 +38,19 @@ from .render import parametric_texts, render_parameter_homotopy, render_system
 @dataclass(frozen=True, eq=False)
 class WarmStart:
     """A real parameter set with its complete set of nonsingular finite solutions (as many as
-    the generic set has, in normalised units): a start for the next point of a sweep."""
+    the generic set has, in normalised units): a start for the next point of a sweep. `before`:
+    the point it was continued from and its solutions in the same order (for a secant
+    prediction along a straight line of points), if it was."""
 
     params: Params
     points: np.ndarray
     generic_key: str
+    before: tuple[Params, np.ndarray] | None = None
+
+    def next_to(self, params: Params, points: np.ndarray, key: str) -> WarmStart:
+        """`params` solved by continuing this start (its `points` in this start's order)."""
+        before = (self.params, self.points) if len(points) == len(self.points) else None
+        return WarmStart(params, points, key, before)
 
 
 # --- continuation from a neighbouring real point ---------------------------------------------
@@ -139,11 +148,16 @@ def _run_homotopy(sub, text: str, points, target: dict, settings: Settings, dead
 
 # --- Newton from the neighbour's solutions ---------------------------------------------------
 
-NEWTON_ITERATIONS = 8
-_CONVERGED = 1e-13  # last Newton step, relative to 1 + |x|
+NEWTON_ITERATIONS = 20
+_CONVERGED = 1e-13  # a point stops iterating when its last Newton step (relative) is below this
+_ACCEPTED = 1e-10  # ... and is a root when its last step is below this (1e-4 of _DISTINCT: a
+# root whose Jacobian is conditioned 1e4 cannot be located to 1e-13, yet it is one root)
 _RESIDUAL = 1e-12  # |f| relative to the coefficients
 _DISTINCT = 1e-6  # two endpoints closer than this (relative) are one: not a complete set
 _CONDITION = 1e8  # a Jacobian worse conditioned than this: not provably nonsingular
+_SUBSTEPS = (2, 4)  # when one step fails: Newton along this many equal steps to the target,
+_DETOUR_STEPS = 8  # then along this many steps of an arc into complex parameters (past folds)
+_DETOUR = 0.5 + 0.5j  # the arc's largest excursion, relative to the step between the points
 
 
 def newton_continue(
@@ -156,18 +170,32 @@ def newton_continue(
     starts converges to a root with a well-conditioned Jacobian and the N roots are distinct.
     No parameter value has more than N isolated nonsingular roots (each persists to nearby
     generic parameters, where there are N: the parameter continuation theorem), so these are all
-    of them, whichever start led to which; the d = 0 roots are singular and computed in closed
-    form. Returns ((endpoints, info, text), "") or (None, why it was refused).
+    of them, whichever start led to which (or however the starts were chosen); the d = 0 roots
+    are singular and computed in closed form. The starts: the neighbour's solutions, or, when
+    the neighbour was itself continued from a point on the same line, their secant
+    extrapolation; if those fail, Newton along 2, then 4, equal steps to the target. Returns
+    ((endpoints, info, text), "") or (None, why the first attempt was refused).
     """
     if warm.generic_key != gs.key or len(warm.points) != len(gs.points):
         return None, "the previous point has another structure or an incomplete set"
     system = polynomial_system(params.normalized())
-    x, size = _newton(system, np.array(warm.points, dtype=complex))
-    if x is None:
-        return None, "a singular Jacobian on the way"
-    why, residual, cond = _newton_refusal(system, x, size)
-    if why:
-        return None, why
+    first = ""
+    for stages, start in _attempts(ps, warm, params):
+        x, size = np.array(start, dtype=complex), None
+        for stage in stages:
+            x, size = _newton(system if stage is None else ps.instantiate(stage), x)
+            if x is None:
+                break
+        why, residual, cond = (
+            ("a singular Jacobian on the way", None, None)
+            if x is None
+            else _newton_refusal(system, x, size)
+        )
+        if not why:
+            break
+        first = first or why
+    else:
+        return None, first
     records = [
         {
             "path_number": i, "condition_number": cond[i], "function_residual": residual[i],
@@ -179,6 +207,40 @@ def newton_continue(
     rep = TrackReport(tracked=len(x), finite=len(x), method="newton")
     info = {**rep.as_dict(), "method": "Newton from the neighbouring point (complete)"}
     return (Endpoints.from_records(ps.variables, records), info, ""), ""
+
+
+def _attempts(ps: ParametricSystem, warm: WarmStart, params: Params) -> Iterator[tuple]:
+    """The Newton attempts in order, made as they are asked for: (the parameter values,
+    normalised, Newton is run at in turn, None for the target itself; the starts)."""
+    secant = _secant(warm, params)
+    yield [None], (warm.points if secant is None else secant)
+    a, b = (
+        np.array([getattr(q.normalized(), n) for n in ps.parameters]) for q in (warm.params, params)
+    )
+    t = np.arange(1, _DETOUR_STEPS) / _DETOUR_STEPS
+    yield [a + (b - a) * (s + 4 * _DETOUR * s * (1 - s)) for s in t] + [None], warm.points
+    for k in _SUBSTEPS:
+        yield [a + (b - a) * j / k for j in range(1, k)] + [None], warm.points
+
+
+def _vector(params: Params) -> np.ndarray:
+    return np.array(list(params.as_dict().values()), dtype=float)
+
+
+def _secant(warm: WarmStart, params: Params) -> np.ndarray | None:
+    """The neighbour's solutions extrapolated along the line from the point before it, when the
+    target lies on that line (a row of a grid, a 1-D sweep), else None."""
+    if warm.before is None:
+        return None
+    before, points = warm.before
+    p0, p1, p2 = (
+        np.array(list(q.as_dict().values()), float) for q in (before, warm.params, params)
+    )
+    back, ahead = p1 - p0, p2 - p1
+    t = float(ahead @ back) / float(back @ back) if back.any() else 0.0
+    if t <= 0 or not np.allclose(ahead, t * back, rtol=0, atol=1e-12 * (1 + np.abs(p2).max())):
+        return None
+    return warm.points + t * (warm.points - points)
 
 
 def _newton(system, x: np.ndarray) -> tuple[np.ndarray | None, np.ndarray]:
@@ -207,7 +269,7 @@ def _newton_refusal(system, x: np.ndarray, size: np.ndarray) -> tuple[str, np.nd
     """Why the Newton endpoints are not a provably complete set ('' when they are), with each
     endpoint's relative residual and Jacobian condition number."""
     nothing = np.zeros(0)
-    if not np.isfinite(x).all() or not (size < _CONVERGED).all():
+    if not np.isfinite(x).all() or not (size < _ACCEPTED).all():
         return "Newton did not converge on every start", nothing, nothing
     # |f_i| relative to its coefficients and to the size of the point (degree d_i).
     grow = (1 + np.abs(x).max(axis=1))[:, None] ** np.array(system.degrees)[None, :]

@@ -3,7 +3,9 @@
 `find_events` reads the branches for folds (and pitchforks: a pair meeting on a third branch),
 stability changes and physical changes, and refines each one's parameter value: a fold by Newton
 on the augmented system (folds.py); the others by bisection along the branch, Newton-correcting
-the branch point at each midpoint.
+the branch point at each midpoint. The table is screened as numpy arrays (point x branch) for
+the intervals where a branch changes realness, a Hessian eigenvalue or a spring length changes
+sign; only those intervals are read row by row.
 """
 
 from __future__ import annotations
@@ -12,12 +14,13 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
-import pandas as pd
 
 from ..params import Params
 from ..settings import Settings
 from .folds import Structure, angles, fold_newton, hessian_eigs, newton, row_x, structure
-from .matching import point_order
+from .matching import point_keys, point_order
+
+Row = Mapping[str, object]  # one row of the sweep table: column -> value
 
 BISECT_TOL = 1e-9  # bisection stops when the bracket is narrower than this
 
@@ -40,11 +43,11 @@ EVENT_COLUMNS = [
 
 
 def find_events(
-    sweep_with_branches: pd.DataFrame,
+    sweep_with_branches,
     param: str,
     base_params: Mapping[str, float] | Params,
     settings: Settings | Mapping | None = None,
-) -> pd.DataFrame:
+):
     """Folds (and pitchforks), stability and physical changes between neighbouring points.
 
     Columns: kind, branches, the parameter (refined value), gamma1_deg, gamma2_deg at the event,
@@ -53,8 +56,28 @@ def find_events(
     |d_i| and the relative |F| there), bracket (the accuracy of the value:
     last Newton step or bracket width), description, lo and hi (the sweep points around it), and
     the point itself: variables, x and (folds) the null vector v of J_x. `settings` are used only
-    for a fresh solve where Newton cannot follow a branch during a bisection.
+    for a fresh solve where Newton cannot follow a branch during a bisection. Returns a DataFrame
+    (`event_records` gives the same rows as dicts, without pandas).
     """
+    import pandas as pd
+
+    events = event_records(sweep_with_branches, param, base_params, settings)
+    return pd.DataFrame(events, columns=event_columns(param))
+
+
+def event_columns(param: str) -> list[str]:
+    """The columns of events.csv for a sweep over `param`."""
+    return EVENT_COLUMNS[:2] + [param] + EVENT_COLUMNS[2:]
+
+
+def event_records(
+    sweep_with_branches,
+    param: str,
+    base_params: Mapping[str, float] | Params,
+    settings: Settings | Mapping | None = None,
+) -> list[dict]:
+    """The rows of `find_events` as dicts, sorted by the parameter, kind and branches.
+    `sweep_with_branches`: a DataFrame or a mapping of numpy columns, with `branch`."""
     if settings is None:
         settings = Settings()
     elif not isinstance(settings, Settings):
@@ -62,33 +85,90 @@ def find_events(
     sw = sweep_with_branches
     base = base_params.as_dict() if isinstance(base_params, Params) else dict(base_params)
     order = point_order(sw, param)
-    key = "point" if "point" in sw.columns else param
-    by_point = {k: sw[sw[key] == k].set_index("branch", drop=False) for k, _ in order}
+    grid = _Grid(sw, param, order)
     events: list[dict] = []
-    for (ka, pa), (kb, pb) in zip(order[:-1], order[1:], strict=True):
-        A, B = by_point[ka], by_point[kb]
+    for r in grid.candidates():
+        (_, pa), (_, pb) = order[r], order[r + 1]
         st = structure(base, param, pa)
         if st.ps.variables != structure(base, param, pb).ps.variables:
             continue  # a change of structure (a free length reaching 0) is not an event
-        ctx = _Ctx(base, param, settings, st, pa, pb, A, B)
-        common = [b for b in A.index if b in B.index and b >= 0]
-        ra = {b: bool(A.loc[b, "is_real"]) for b in common}
-        rb = {b: bool(B.loc[b, "is_real"]) for b in common}
-        here: list[dict] = []
-        for b in common:
-            if ra[b] and rb[b]:
-                here.extend(_along_branch_events(ctx, b))
-        for real_side, group in (
-            ("left", [b for b in common if ra[b] and not rb[b]]),
-            ("right", [b for b in common if rb[b] and not ra[b]]),
-        ):
-            complex_side = B if real_side == "left" else A
-            for pair in _conjugate_pairs(group, complex_side, st.ps.variables):
-                third = [b for b in common if ra[b] and rb[b]]
-                here.extend(_fold_events(ctx, pair, real_side, third, here))
-        events.extend(here)
-    frame = pd.DataFrame(events, columns=EVENT_COLUMNS[:2] + [param] + EVENT_COLUMNS[2:])
-    return frame.sort_values([param, "kind", "branches"], kind="stable").reset_index(drop=True)
+        A, B = grid.rows(r), grid.rows(r + 1)
+        events.extend(_interval_events(_Ctx(base, param, settings, st, pa, pb, A, B)))
+    nan_last = [(v[param] != v[param], v[param], v["kind"], v["branches"]) for v in events]
+    return [events[k] for k in sorted(range(len(events)), key=nan_last.__getitem__)]
+
+
+def _interval_events(ctx: _Ctx) -> list[dict]:
+    """The events between two neighbouring points."""
+    A, B = ctx.A, ctx.B
+    common = [b for b in A if b in B and b >= 0]
+    ra = {b: bool(A[b]["is_real"]) for b in common}
+    rb = {b: bool(B[b]["is_real"]) for b in common}
+    here: list[dict] = []
+    for b in common:
+        if ra[b] and rb[b]:
+            here.extend(_along_branch_events(ctx, b))
+    for real_side, group in (
+        ("left", [b for b in common if ra[b] and not rb[b]]),
+        ("right", [b for b in common if rb[b] and not ra[b]]),
+    ):
+        complex_side = B if real_side == "left" else A
+        for pair in _conjugate_pairs(group, complex_side, ctx.st.ps.variables):
+            third = [b for b in common if ra[b] and rb[b]]
+            here.extend(_fold_events(ctx, pair, real_side, third, here))
+    return here
+
+
+class _Grid:
+    """The sweep's rows indexed by (point in parameter order, branch), for the screening."""
+
+    SCREENED = ("is_real", "hess_eig1", "hess_eig2", "d1", "d2")
+
+    def __init__(self, sw, param: str, order: list[tuple[object, float]]):
+        self.sw = sw
+        self.columns = {n: np.asarray(sw[n]) for n in sw}
+        keys, _ = point_keys(sw, param)
+        rank = {k: r for r, (k, _) in enumerate(order)}
+        row_rank = np.array([rank[k] for k in keys.tolist()], dtype=int)
+        branch = np.asarray(sw["branch"], dtype=int)
+        self.row_rank, self.branch = row_rank, branch
+        width = int(branch.max()) + 1 if len(branch) else 0
+        self.index = np.full((len(order), max(width, 1)), -1, dtype=int)
+        rows = np.flatnonzero(branch >= 0)
+        self.index[row_rank[rows], branch[rows]] = rows
+
+    def _values(self, name: str) -> np.ndarray:
+        col = np.asarray(self.sw[name], dtype=float)
+        return np.where(self.index >= 0, col[self.index], np.nan)
+
+    def candidates(self) -> list[int]:
+        """The intervals (r, r + 1) where some branch present at both points changes realness,
+        or, real at both, has a Hessian eigenvalue or a spring length change sign (or NaN)."""
+        if len(self.index) < 2:
+            return []
+        have = self.index >= 0
+        both = have[:-1] & have[1:]
+        real = np.asarray(self.sw["is_real"], dtype=bool)[self.index] & have
+        flips = both & (real[:-1] != real[1:])
+        real_both = both & real[:-1] & real[1:]
+        changes = np.zeros_like(flips)
+        eig = [self._values(f"hess_eig{i}") for i in (1, 2)]
+        finite = np.isfinite(eig[0]) & np.isfinite(eig[1])
+        ok = finite[:-1] & finite[1:]
+        for e in eig:
+            changes |= ok & (np.sign(e[:-1]) != np.sign(e[1:]))
+        for i in (1, 2):
+            if f"d{i}" not in self.sw:
+                continue
+            d = self._values(f"d{i}")
+            lo, hi = np.fmin(d[:-1], d[1:]), np.fmax(d[:-1], d[1:])
+            changes |= np.isnan(d[:-1]) | np.isnan(d[1:]) | ((lo < 0) & (hi > 0))
+        return np.flatnonzero((flips | (real_both & changes)).any(axis=1)).tolist()
+
+    def rows(self, r: int) -> dict[int, Row]:
+        """Point r's rows by branch (each a dict of its columns; branch -1 rows left out)."""
+        rows = np.flatnonzero((self.row_rank == r) & (self.branch >= 0))
+        return {int(self.branch[i]): {n: c[i] for n, c in self.columns.items()} for i in rows}
 
 
 @dataclass(frozen=True)
@@ -99,8 +179,8 @@ class _Ctx:
     st: Structure
     pa: float
     pb: float
-    A: pd.DataFrame
-    B: pd.DataFrame
+    A: dict[int, Row]  # the rows of the points on either side, by branch
+    B: dict[int, Row]
 
     def event(self, kind: str, branches: str, value: float, x: np.ndarray, **info) -> dict:
         g1, g2 = angles(self.st.ps.variables, x)
@@ -119,16 +199,14 @@ class _Ctx:
         }
 
 
-def _conjugate_pairs(group: list[int], side: pd.DataFrame, variables) -> list[tuple[int, int]]:
+def _conjugate_pairs(group: list[int], side: dict[int, Row], variables) -> list[tuple[int, int]]:
     """Pair the branches of `group` whose points on the complex `side` are conjugates."""
     left = sorted(group)
     pairs = []
     while len(left) >= 2:
         gaps = [
             (
-                np.abs(
-                    row_x(side.loc[a], variables) - np.conj(row_x(side.loc[b], variables))
-                ).max(),
+                np.abs(row_x(side[a], variables) - np.conj(row_x(side[b], variables))).max(),
                 a,
                 b,
             )
@@ -141,14 +219,14 @@ def _conjugate_pairs(group: list[int], side: pd.DataFrame, variables) -> list[tu
     return pairs
 
 
-def _label(row: pd.Series) -> str:
+def _label(row: Row) -> str:
     if bool(row["physical"]):
         return str(row["kind"]) or "physical"
     return str(row["reason"]) if isinstance(row["reason"], str) and row["reason"] else "real"
 
 
 def _refine_fold(
-    ctx: _Ctx, R: pd.DataFrame, C: pd.DataFrame, pair: tuple[int, int], pr: float, pc: float
+    ctx: _Ctx, R: dict[int, Row], C: dict[int, Row], pair: tuple[int, int], pr: float, pc: float
 ) -> tuple[np.ndarray, np.ndarray, float, float, bool, float]:
     """Newton on the augmented system from an interpolated start: (x, v, p, acc, ok, resid).
 
@@ -156,8 +234,8 @@ def _refine_fold(
     """
     a, b = pair
     variables = ctx.st.ps.variables
-    xa_r, xb_r = row_x(R.loc[a], variables).real, row_x(R.loc[b], variables).real
-    xa_c, xb_c = row_x(C.loc[a], variables), row_x(C.loc[b], variables)
+    xa_r, xb_r = row_x(R[a], variables).real, row_x(R[b], variables).real
+    xa_c, xb_c = row_x(C[a], variables), row_x(C[b], variables)
     # Near a fold |x_a - x_b|^2 grows like |p - p*| on both sides: interpolate it to zero.
     dr, dc = np.sum((xa_r - xb_r) ** 2), np.sum(np.abs(xa_c - xb_c) ** 2)
     p0 = (dr * pc + dc * pr) / (dr + dc) if dr + dc > 0 else 0.5 * (pr + pc)
@@ -191,7 +269,7 @@ def _pitchfork_branch(ctx: _Ctx, third: list[int], p: float, x: np.ndarray) -> i
     variables = ctx.st.ps.variables
     for c in third:
         xc = _interpolate(ctx, c, p)
-        step = row_x(ctx.B.loc[c], variables).real - row_x(ctx.A.loc[c], variables).real
+        step = row_x(ctx.B[c], variables).real - row_x(ctx.A[c], variables).real
         if np.abs(xc - x).max() < max(1e-3, 0.1 * np.abs(step).max()):
             return c
     return None
@@ -207,13 +285,13 @@ def _fold_events(
     R, C = (ctx.A, ctx.B) if real_side == "left" else (ctx.B, ctx.A)
     pr, pc = (ctx.pa, ctx.pb) if real_side == "left" else (ctx.pb, ctx.pa)
     x, v, p, acc, ok, resid = _refine_fold(ctx, R, C, pair, pr, pc)
-    la, lb = _label(R.loc[a]), _label(R.loc[b])
+    la, lb = _label(R[a]), _label(R[b])
     side, other = ("above", "below") if pr > pc else ("below", "above")
     kind, on = "fold", ""
     c = _pitchfork_branch(ctx, third, p, x)
     if c is not None:
         kind = "pitchfork"
-        on = f" on branch {c} ({_label(ctx.A.loc[c])} below, {_label(ctx.B.loc[c])} above)"
+        on = f" on branch {c} ({_label(ctx.A[c])} below, {_label(ctx.B[c])} above)"
         for e in along:
             if e["kind"] == "stability_change" and e["branches"] == str(c) and ok:
                 e[ctx.param], e["refined"], e["bracket"] = float(p), True, acc
@@ -227,7 +305,7 @@ def _fold_events(
         null_vector=tuple(float(c) for c in v),
     )  # fmt: skip
     out = [event]
-    ra, rb = R.loc[a], R.loc[b]
+    ra, rb = R[a], R[b]
     physical_pair = bool(ra["physical"]) and bool(rb["physical"])
     if kind == "fold" and physical_pair and bool(ra["stable"]) != bool(rb["stable"]):
         (s, ls), (u, lu) = ((a, la), (b, lb)) if bool(ra["stable"]) else ((b, lb), (a, la))
@@ -247,14 +325,14 @@ def _fold_events(
 def _interpolate(ctx: _Ctx, b: int, value: float) -> np.ndarray:
     """Branch b's real point at `value`, linear between the interval's ends."""
     variables = ctx.st.ps.variables
-    xa, xb = row_x(ctx.A.loc[b], variables).real, row_x(ctx.B.loc[b], variables).real
+    xa, xb = row_x(ctx.A[b], variables).real, row_x(ctx.B[b], variables).real
     t = (value - ctx.pa) / (ctx.pb - ctx.pa)
     return (1 - t) * xa + t * xb
 
 
 def _along_branch_events(ctx: _Ctx, b: int) -> list[dict]:
     """Stability and physical changes along one branch that is real at both points."""
-    ra, rb = ctx.A.loc[b], ctx.B.loc[b]
+    ra, rb = ctx.A[b], ctx.B[b]
     variables = ctx.st.ps.variables
     out = []
     ea = np.array([ra["hess_eig1"], ra["hess_eig2"]], float)
@@ -321,7 +399,7 @@ def _bisect(ctx: _Ctx, b: int, fn) -> tuple[float, np.ndarray, float, bool, floa
     """
     variables = ctx.st.ps.variables
     lo, hi = ctx.pa, ctx.pb
-    xlo, xhi = row_x(ctx.A.loc[b], variables).real, row_x(ctx.B.loc[b], variables).real
+    xlo, xhi = row_x(ctx.A[b], variables).real, row_x(ctx.B[b], variables).real
     flo = fn(lo, xlo)
     ok, resolves = True, 2
     while abs(hi - lo) > BISECT_TOL:

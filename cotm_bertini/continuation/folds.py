@@ -10,7 +10,6 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
-import pandas as pd
 
 from ..model.compiled import energy_hessian, parametric_system
 from ..model.polynomial import ParametricSystem, PolySystem
@@ -118,5 +117,6 @@ def hessian_eigs(st: Structure, value: float, variables, x: np.ndarray) -> np.nd
     return np.linalg.eigvalsh(energy_hessian(st.params(value), g1, g2))[0]
 
 
-def row_x(row: pd.Series, variables: tuple[str, ...]) -> np.ndarray:
+def row_x(row: Mapping[str, float], variables: tuple[str, ...]) -> np.ndarray:
+    """A row's solver coordinates (the `<var>_re`, `<var>_im` columns) as a complex vector."""
     return np.array([row[f"{v}_re"] + 1j * row[f"{v}_im"] for v in variables])

@@ -1,19 +1,24 @@
-"""Finish a sweep: sweep.csv with branches, events.csv, columns.md and run.json."""
+"""Finish a sweep: sweep.csv with branches, events.csv, columns.md and run.json.
+
+Everything here works on numpy columns (the points as the runner keeps them in memory, or as
+the folder's store holds them): no pandas, no CSV read back.
+"""
 
 from __future__ import annotations
 
 import time
+from collections import Counter
 from pathlib import Path
 
-import pandas as pd
+import numpy as np
 
 from ..columns import reference
-from ..fs import atomic_write_text, write_csv, write_json
+from ..fs import atomic_write_text, write_json
 from ..versions import versions
-from .runner import assemble
+from .runner import assemble_columns, sweep_names
 from .spec import SweepSpec
-
-EVENT_FRAME_COLUMNS = ["kind", "branches", "gamma1_deg", "gamma2_deg"]
+from .store import PointStore
+from .tables import Columns, csv_text, rows_text, union_names
 
 
 def finish(
@@ -23,39 +28,91 @@ def finish(
     workers: int = 1,
     scheduler: str | None = None,
     command: list[str] | None = None,
+    store: PointStore | None = None,
 ) -> dict:
-    """Assemble sweep.csv (with branches for 1-D sweeps), events.csv and run.json."""
+    """Assemble sweep.csv (with branches for 1-D sweeps), events.csv and run.json; returns the
+    run record. `store`: the folder's points, already in memory (default: read from disk)."""
+    record, _ = finish_columns(spec, folder, stats, workers, scheduler, command, store)
+    return record
+
+
+def finish_columns(
+    spec: SweepSpec,
+    folder: Path,
+    stats: dict,
+    workers: int = 1,
+    scheduler: str | None = None,
+    command: list[str] | None = None,
+    store: PointStore | None = None,
+) -> tuple[dict, Columns]:
+    """`finish`, returning (the run record, the table as numpy columns, branch included)."""
     from ..params import Params
-    from .events import find_events
-    from .matching import assign_branches
+    from .events import event_columns, event_records
+    from .matching import branch_ids
 
     t0 = time.perf_counter()
-    table = assemble(spec, folder)
-    events = pd.DataFrame(columns=EVENT_FRAME_COLUMNS[:2] + [spec.param] + EVENT_FRAME_COLUMNS[2:])
+    store = PointStore(folder) if store is None else store
+    table = assemble_columns(spec, folder, store)
+    events: list[dict] = []
     if spec.param2 is None:
-        table = assign_branches(table, spec.param)
-        events = find_events(table, spec.param, Params(**spec.base), spec.settings)
-    write_csv(folder / "sweep.csv", table)
-    write_csv(folder / "events.csv", events)
+        table["branch"] = branch_ids(table, spec.param)
+        events = event_records(table, spec.param, Params(**spec.base), spec.settings)
+    atomic_write_text(folder / "sweep.csv", _sweep_text(spec, store, table.get("branch")))
+    names = event_columns(spec.param)
+    atomic_write_text(folder / "events.csv", csv_text({n: [e[n] for e in events] for n in names}))
     atomic_write_text(folder / "columns.md", reference("sweep", "events", "solutions"))
-    incomplete = sorted(set(table.loc[table["status"] != "ok", "point"])) if len(table) else []
-    record = {
+    record = _record(spec, table, len(events), stats, workers, scheduler, command)
+    record["timings"] = {"solve": stats["seconds"], "finish": time.perf_counter() - t0}
+    write_json(folder / "run.json", record)
+    return record, table
+
+
+def _sweep_text(spec: SweepSpec, store: PointStore, branch: np.ndarray | None) -> str:
+    """sweep.csv: the header, then each point's lines (written by the workers under the
+    columns `sweep_names` foresaw, else here), with the branch column for 1-D sweeps."""
+    parts = [store.points[i] for i in range(spec.size())]
+    names = union_names(parts)
+    texts = store.texts if names == sweep_names(spec) else {}
+    pieces = [",".join(names + (["branch"] if branch is not None else [])) + "\n"]
+    row = 0
+    for index, part in enumerate(parts):
+        text = texts.get(index)
+        text = rows_text(part, names) if text is None else text
+        if branch is not None and text:
+            lines = text.split("\n")[:-1]
+            ids = branch[row : row + len(lines)].tolist()
+            text = "".join(f"{line},{b}\n" for line, b in zip(lines, ids, strict=True))
+            row += len(lines)
+        pieces.append(text)
+    return "".join(pieces)
+
+
+def _record(spec: SweepSpec, table: Columns, events: int, stats, workers, scheduler, command):
+    """run.json: the request, counts, status, methods and versions."""
+    rows = len(table["point"]) if "point" in table else 0
+    status = np.asarray(table.get("status", np.zeros(0)), dtype=object)
+    point = np.asarray(table.get("point", np.zeros(0)), dtype=int)
+    incomplete = sorted(set(point[status != "ok"].tolist())) if rows else []
+    lost = 0
+    if rows:
+        per_point = np.asarray(table["lost_paths"], dtype=float)
+        first = np.unique(point, return_index=True)[1]  # a point's rows share its lost_paths
+        lost = int(np.nansum(per_point[first]))
+    methods = dict(Counter(table["method"].tolist()).most_common()) if rows else {}
+    return {
         "spec": spec.to_json(),
         "key": spec.key(),
         "command": command,
         "points": spec.size(),
-        "rows": len(table),
-        "events": len(events),
+        "rows": rows,
+        "events": events,
         "status": "incomplete" if incomplete else "ok",
         "incomplete_points": [int(p) for p in incomplete],
         "stats": stats,
         "workers": workers,
         "scheduler": scheduler,
-        "methods": table["method"].value_counts().to_dict() if len(table) else {},
-        "lost_paths": int(table.groupby("point")["lost_paths"].max().sum()) if len(table) else 0,
+        "methods": methods,
+        "lost_paths": lost,
         "versions": versions(),
         "figures": [],
-        "timings": {"solve": stats["seconds"], "finish": time.perf_counter() - t0},
     }
-    write_json(folder / "run.json", record)
-    return record

@@ -1,27 +1,30 @@
-"""Run a sweep: every point solved by `solve_point`, in parallel, each stored atomically, resumable.
+"""Run a sweep: every point solved by `solve_point`, in parallel, each stored durably, resumable.
 
-Each point's rows are written to `points/NNNNN.csv` atomically as soon as the point is solved, so a
-killed sweep loses at most the points in flight and never writes a partial or duplicate row; a
-rerun skips the points whose file exists. `sweep.csv` is assembled from them at the end.
+Each point's columns are appended to the sweep folder's store (`points.bin`, continuation.store)
+as soon as the point is solved, and kept in memory for the end, so a killed sweep loses at most
+the points in flight and never stores a partial or duplicate row; a rerun skips the points
+already stored. `sweep.csv` is assembled from the points at the end.
 """
 
 from __future__ import annotations
 
 import json
 import os
+import sys
 import time
 from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 
 import numpy as np
 
-from ..analysis.classify import read_table
 from ..errors import ParameterError
-from ..fs import atomic_write_text, columns_csv, write_json
+from ..fs import write_json
 from ..params import Params
 from ..point import PointSolution, solve_point
 from ..settings import Settings
 from .spec import SweepSpec
+from .store import PointStore, stored_indices
+from .tables import Columns, concat_columns, rows_text, to_frame
 
 SPEC_FILE = "sweep.json"
 
@@ -53,20 +56,65 @@ def point_table(params: Params, settings: Settings, values: dict[str, float]):
     return table
 
 
-def solve_run(spec: SweepSpec, indices: list[int]) -> Iterator[tuple[int, str, int]]:
-    """Solve grid points in order, each continued from the one before when they are neighbours:
-    yields (index, the point's CSV text, lost paths)."""
+def solve_run(
+    spec: SweepSpec, indices: list[int], names: list[str] | None = None
+) -> Iterator[tuple[int, Columns, int, str | None]]:
+    """Solve grid points in order, each continued from a solved neighbour: the one before when
+    it has the same structure, else another one solved in this run (the row before, on a
+    2-D grid: so a point next to a free length of 0 need not start from the generic set).
+    Yields (index, the point's columns, lost paths, its sweep.csv lines under the columns
+    `names`, or None without `names`): the lines are written here, in parallel, not at the end.
+    """
     settings = point_settings(spec)
-    warm, previous = None, None
+    recent: dict[int, tuple] = {}  # the last two rows' points: index -> (warm start, structure)
+    keep = 2 * (len(spec.values2) if spec.param2 else 1) + 2
     for index in indices:
-        if previous is None or not spec.neighbours(previous, index):
-            warm = None
-        solved = solve_point(spec.params_at(index), settings, warm=warm)
-        warm, previous = solved.warm, index
+        params = spec.params_at(index)
+        solved = solve_point(params, settings, warm=_start(spec, index, params.zfl, recent))
+        recent[index] = (solved.warm, params.zfl)
+        if len(recent) > keep:
+            del recent[next(iter(recent))]
         cols = point_columns(solved, spec.values_at(index), index)
         if spec.certify:
-            _certify_point(spec.params_at(index), solved, cols)
-        yield index, columns_csv(cols), int(np.nan_to_num(cols["lost_paths"][:1]).sum())
+            _certify_point(params, solved, cols)
+        text = None if names is None else rows_text(cols, names)
+        yield index, cols, int(np.nan_to_num(cols["lost_paths"][:1]).sum()), text
+
+
+def sweep_names(spec: SweepSpec) -> list[str]:
+    """The columns of sweep.csv (before `branch`), from the structures the grid holds: each
+    point's columns in point_columns' order, joined in grid order (as pandas.concat joins)."""
+    from ..analysis.classify import empty_columns
+    from ..model.compiled import parametric_system
+
+    structures: dict[tuple[bool, bool], None] = {}  # Params.zfl of each point, in grid order
+    for index in range(spec.size() if {"L01", "L02"} & set(spec.columns) else 1):
+        values = {**spec.base, **spec.values_at(index)}
+        structures[(float(values["L01"]) == 0.0, float(values["L02"]) == 0.0)] = None
+    names: dict[str, None] = dict.fromkeys(["point", *spec.columns])
+    for zfl in structures:
+        names.update(dict.fromkeys(empty_columns(parametric_system(zfl).variables)))
+        names.update(dict.fromkeys(["method", "lost_paths", "status"]))
+        if spec.certify:
+            names.update(dict.fromkeys(CERTIFY_COLUMNS))
+    return list(names)
+
+
+CERTIFY_COLUMNS = ("certified", "certified_radius", "certificate", "certify_seconds")
+
+
+def _start(spec: SweepSpec, index: int, zfl, recent: dict[int, tuple]):
+    """The warm start of point `index`: the last point solved if it is a neighbour of the same
+    structure, else another solved neighbour of that structure, else the last point if it is a
+    neighbour (it is then refused, and says why), else None."""
+    last = next(reversed(recent), None)
+    near = [i for i in [last, *spec.grid_neighbours(index)] if i in recent]
+    near = [i for i in near if spec.neighbours(i, index)]
+    for i in near:
+        warm, structure = recent[i]
+        if warm is not None and structure == zfl:
+            return warm
+    return recent[last][0] if near and near[0] == last else None
 
 
 def _certify_point(params: Params, solved: PointSolution, cols: dict) -> None:
@@ -76,17 +124,16 @@ def _certify_point(params: Params, solved: PointSolution, cols: dict) -> None:
 
     cert = certify_table(params, solved.columns)
     n = len(cols["point"])
-    cols["certified"] = cert.certified
-    cols["certified_radius"] = cert.certified_radius
-    cols["certificate"] = np.full(n, cert.status, dtype=object)
-    cols["certify_seconds"] = np.full(n, cert.seconds)
+    values = (cert.certified, cert.certified_radius, np.full(n, cert.status, dtype=object),
+              np.full(n, cert.seconds))  # fmt: skip
+    cols.update(zip(CERTIFY_COLUMNS, values, strict=True))
     if cert.status != "proved":
         cols["status"] = np.full(n, "incomplete", dtype=object)
 
 
-def _run_task(args: tuple) -> list[tuple[int, str, int]]:
-    indices, spec_json = args
-    return list(solve_run(SweepSpec.from_json(spec_json), indices))
+def _run_task(args: tuple) -> list[tuple[int, Columns, int, str | None]]:
+    indices, spec_json, names = args
+    return list(solve_run(SweepSpec.from_json(spec_json), indices, names))
 
 
 def point_settings(spec: SweepSpec) -> Settings:
@@ -95,16 +142,10 @@ def point_settings(spec: SweepSpec) -> Settings:
     return settings if settings.threads is not None else settings.replace(threads=1)
 
 
-def point_file(folder: Path, index: int) -> Path:
-    """Where point `index` is stored."""
-    return folder / "points" / f"{index:05d}.csv"
-
-
-def pending_points(spec: SweepSpec, folder: Path) -> list[int]:
-    """Indices of the grid points that have no finished point file yet."""
-    points = folder / "points"
-    done = {p.name for p in points.glob("*.csv")} if points.is_dir() else set()
-    return [i for i in range(spec.size()) if point_file(folder, i).name not in done]
+def pending_points(spec: SweepSpec, folder: Path, store: PointStore | None = None) -> list[int]:
+    """Indices of the grid points not stored yet."""
+    done = stored_indices(folder) if store is None else store.points
+    return [i for i in range(spec.size()) if i not in done]
 
 
 def prepare(spec: SweepSpec, folder: Path) -> Path:
@@ -117,9 +158,8 @@ def prepare(spec: SweepSpec, folder: Path) -> Path:
         if saved.get("spec") != spec.to_json():
             raise ParameterError(f"{folder}: holds a different sweep; write to another folder")
     else:
-        (folder / "points").mkdir(parents=True, exist_ok=True)
+        folder.mkdir(parents=True, exist_ok=True)
         write_json(spec_path, {"spec": spec.to_json(), "key": spec.key()})
-    (folder / "points").mkdir(parents=True, exist_ok=True)
     return folder
 
 
@@ -149,14 +189,17 @@ def run_points(
     workers: int = 1,
     scheduler: str | None = None,
     progress: Callable[[int, int, int], None] | None = None,
+    store: PointStore | None = None,
 ) -> dict:
-    """Solve every pending point (local processes, or a Dask cluster) and store each atomically.
+    """Solve every pending point (local processes, or a Dask cluster) and store each durably
+    (in `store`, the folder's PointStore, which also keeps them in memory, if given).
 
     Pending points are cut into runs of grid neighbours (snake order over a 2-D grid); each run
     is solved in order on one worker, every point continued from the one before.
     """
     check_workers(workers)
-    todo = pending_points(spec, folder)
+    store = PointStore(folder) if store is None else store
+    todo = pending_points(spec, folder, store)
     total = spec.size()
     stats = {"points": total, "skipped": total - len(todo), "solved": 0, "lost_paths": 0}
     stats["seconds"] = 0.0
@@ -165,24 +208,28 @@ def run_points(
     warm_generic_sets(spec)
     start = time.perf_counter()
     runs = spec.runs(todo, parts=1 if (workers == 1 and scheduler is None) else 2 * workers)
-    for index, text, lost in _execute(runs, spec, workers, scheduler):
-        atomic_write_text(point_file(folder, index), text)
-        stats["solved"] += 1
-        stats["lost_paths"] += lost
-        if progress:
-            progress(stats["solved"], len(todo), stats["lost_paths"])
+    names = sweep_names(spec)
+    try:
+        for index, cols, lost, text in _execute(runs, spec, workers, scheduler, names):
+            store.append(index, cols, text)
+            stats["solved"] += 1
+            stats["lost_paths"] += lost
+            if progress:
+                progress(stats["solved"], len(todo), stats["lost_paths"])
+    finally:
+        store.close()
     stats["seconds"] = time.perf_counter() - start
     return stats
 
 
 def _execute(
-    runs: list[list[int]], spec: SweepSpec, workers: int, scheduler: str | None
-) -> Iterable[tuple[int, str, int]]:
+    runs: list[list[int]], spec: SweepSpec, workers: int, scheduler: str | None, names: list[str]
+) -> Iterable[tuple[int, Columns, int, str | None]]:
     if scheduler is None and workers == 1:
         for run in runs:
-            yield from solve_run(spec, run)  # in process: point by point, progress as it goes
+            yield from solve_run(spec, run, names)  # in process: point by point, with progress
         return
-    tasks = [(run, spec.to_json()) for run in runs]
+    tasks = [(run, spec.to_json(), names) for run in runs]
     if scheduler is not None:
         from distributed import Client, as_completed
 
@@ -193,21 +240,36 @@ def _execute(
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
-    ctx = mp.get_context("spawn")  # the bertini module is not fork-safe with its threads
+    ctx = mp.get_context(_start_method())
     with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
         for fut in as_completed([pool.submit(_run_task, t) for t in tasks]):
             yield from fut.result()
 
 
-def assemble(spec: SweepSpec, folder: Path):
-    """All point files as one table (DataFrame), in grid order (errors if a point is missing)."""
-    import pandas as pd
+def _start_method() -> str:
+    """How worker processes start: `fork` while this process has not loaded the bertini module
+    and runs no other thread (the workers then begin with numpy, this package and the generic
+    sets already loaded), else `spawn` (the bertini module is not fork-safe with its threads)."""
+    import threading
 
-    missing = pending_points(spec, folder)
+    if sys.platform == "linux" and "bertini" not in sys.modules and threading.active_count() == 1:
+        return "fork"
+    return "spawn"
+
+
+def assemble_columns(spec: SweepSpec, folder: Path, store: PointStore | None = None) -> Columns:
+    """Every point's rows as one table of numpy columns, in grid order, from `store` (default:
+    the folder's); errors if a point is missing."""
+    store = PointStore(folder) if store is None else store
+    missing = pending_points(spec, folder, store)
     if missing:
         raise RuntimeError(f"{folder}: {len(missing)} points not solved yet (first {missing[0]})")
-    frames = [read_table(point_file(folder, i)) for i in range(spec.size())]
-    return pd.concat(frames, ignore_index=True)
+    return concat_columns([store.points[i] for i in range(spec.size())])
+
+
+def assemble(spec: SweepSpec, folder: Path, store: PointStore | None = None):
+    """Every point's rows as one DataFrame, in grid order, with the dtypes of sweep.csv."""
+    return to_frame(assemble_columns(spec, folder, store))
 
 
 def check_workers(workers: object) -> None:

@@ -102,6 +102,15 @@ class SweepSpec:
         (ia, ja), (ib, jb) = divmod(a, n2), divmod(b, n2)
         return abs(ia - ib) + abs(ja - jb) == 1
 
+    def grid_neighbours(self, index: int) -> list[int]:
+        """The grid points next to `index` (one step in one parameter)."""
+        if self.param2 is None:
+            return [i for i in (index - 1, index + 1) if 0 <= i < len(self.values)]
+        n2 = len(self.values2)
+        i, j = divmod(index, n2)
+        near = ((i - 1, j), (i + 1, j), (i, j - 1), (i, j + 1))
+        return [a * n2 + b for a, b in near if 0 <= a < len(self.values) and 0 <= b < n2]
+
     def snake(self) -> list[int]:
         """Every grid index, each one a neighbour of the one before (rows alternate direction)."""
         if self.param2 is None:

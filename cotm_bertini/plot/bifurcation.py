@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from pathlib import Path
 
 import matplotlib
@@ -12,6 +13,7 @@ from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
+from ..params import PARAM_NAMES, PARAM_UNITS, TABLE1
 from .common import flag, param_label, save
 
 # Styles of the bifurcation diagram: line width and style, marker size (points^2).
@@ -22,9 +24,14 @@ EVENT_STYLE = {  # marker, colour, size, label
     "stability_change": ("D", "black", 95, "stability change"),
     "physical_change": ("v", "0.35", 60, "physical change (a spring length crosses 0)"),
 }
+# Drawn over one another where they coincide (a stability change at a fold): the fold's cross
+# stays visible on top of the stability change's diamond.
+EVENT_ZORDER = {"fold": 8, "pitchfork": 8, "stability_change": 6, "physical_change": 7}
 # Two consecutive samples of a branch further apart than this (short way round, deg) are not
 # joined: the branch is poorly resolved there, and a long line would only mislead.
 _MAX_STEP_DEG = 90.0
+# Events where branches are born or end (two real branches meet there).
+_MEETING_KINDS = ("fold", "pitchfork")
 
 
 def _branch_links(
@@ -109,20 +116,25 @@ def _styled_rows(sweep: pd.DataFrame, show_all: bool) -> pd.DataFrame:
     return rows.assign(_style=style)
 
 
-def _draw_lines(ax, rows: pd.DataFrame, param: str, angle: str, rank_of: dict, colour_of: dict):
-    """Each branch's samples joined, one LineCollection per style."""
+def _draw_lines(
+    ax, rows: pd.DataFrame, param: str, angle: str, rank_of: dict, colour_of: dict, events=None
+):
+    """Each branch's samples joined, one LineCollection per style; a branch born (or ending) at
+    a fold of `events` is joined to the fold point itself."""
     pieces: dict[str, list] = {"stable": [], "unstable": [], "nonphysical": []}
     colours: dict[str, list] = {"stable": [], "unstable": [], "nonphysical": []}
     joined = rows.dropna(subset=["branch"])
+    meetings = _meetings(events, param, angle)
+    values = np.array(sorted(rank_of), dtype=float)
     for branch, grp in joined[joined["branch"] >= 0].groupby("branch", sort=True):
         grp = grp.sort_values(param, kind="stable")
         x = grp[param].to_numpy(dtype=float)
-        for style_name, pts in _branch_links(
-            x,
-            grp[angle].to_numpy(dtype=float) % 360.0,
-            np.array([rank_of[v] for v in x]),
-            list(grp["_style"]),
-        ):
+        y = grp[angle].to_numpy(dtype=float) % 360.0
+        styles = list(grp["_style"])
+        links = _branch_links(x, y, np.array([rank_of[v] for v in x]), styles)
+        for at, fold_y in meetings.get(int(branch), []):
+            links += _fold_link(at, fold_y, x, y, styles, values)
+        for style_name, pts in links:
             pieces[style_name].append(pts)
             colours[style_name].append(
                 _NONPHYSICAL_COLOUR
@@ -141,6 +153,43 @@ def _draw_lines(ax, rows: pd.DataFrame, param: str, angle: str, rank_of: dict, c
             joinstyle="round",
         )
         ax.add_collection(coll)
+
+
+def _meetings(events, param: str, angle: str) -> dict[int, list[tuple[float, float]]]:
+    """For each branch, the (parameter, angle) of the folds (and pitchforks) it takes part in."""
+    out: dict[int, list[tuple[float, float]]] = {}
+    if events is None or not len(events) or "branches" not in events:
+        return out
+    at = "value" if "value" in events else param
+    for ev in events[events["kind"].isin(_MEETING_KINDS)].itertuples(index=False):
+        ev = ev._asdict()
+        point = (float(ev[at]), float(ev[angle]) % 360.0)
+        for b in str(ev["branches"]).split("+"):
+            if b.strip().isdigit():
+                out.setdefault(int(b), []).append(point)
+    return out
+
+
+def _fold_link(
+    at: float, fold_y: float, x: np.ndarray, y: np.ndarray, styles: list[str], values: np.ndarray
+) -> list[tuple[str, np.ndarray]]:
+    """The branch's line from a fold point to its sample at the next parameter value on either
+    side (the branch is real on one side of its fold only), in that sample's style; nothing if
+    the branch has no sample there or the angle jumps."""
+    k = int(np.searchsorted(values, at))
+    near = {values[j] for j in (k - 1, k) if 0 <= j < len(values)}
+    if at in near:
+        near = {at}
+    out = []
+    for i in np.flatnonzero([v in near for v in x]):
+        step = (y[i] - fold_y + 180.0) % 360.0 - 180.0
+        if abs(step) > _MAX_STEP_DEG:
+            continue
+        a, b = np.array([at, fold_y]), np.array([x[i], fold_y + step])
+        if b[0] < a[0]:  # left to right, the sample's angle as the start
+            a, b = np.array([x[i], y[i]]), np.array([at, y[i] - step])
+        out += [(styles[i], np.array(seg)) for seg in _cut_at_edges(a, b)]
+    return out
 
 
 def _draw_markers(ax, rows, param: str, angle: str, dense: bool, colour_of: dict | None) -> None:
@@ -183,7 +232,7 @@ def _draw_events(ax, events: pd.DataFrame | None, param: str, angle: str) -> Non
             c="none" if filled else colour,
             edgecolors=colour if filled else None,
             linewidths=1.3 if filled else 1.6,
-            zorder=6,
+            zorder=EVENT_ZORDER.get(kind, 6),
             gid=kind,
         )
 
@@ -224,6 +273,7 @@ def bifurcation_figure(
     param: str,
     show_all: bool = False,
     events: pd.DataFrame | None = None,
+    fixed: Mapping[str, float] | None = None,
 ) -> Figure:
     """gamma1 (top panel) and gamma2 (bottom panel) of the equilibria against `param`.
 
@@ -235,7 +285,9 @@ def bifurcation_figure(
     stable, thin and dashed where unstable; never across 0/360 deg or a gap (see _branch_links).
     With branches and more than 60 parameter values the lines carry the picture: only the stable
     markers are drawn (small, on the thick lines). `events` (columns kind, value, gamma1_deg,
-    gamma2_deg) are marked in both panels.
+    gamma2_deg) are marked in both panels, a fold's cross above a stability change's diamond;
+    with their `branches` column (a+b), the branches that meet at a fold are drawn from the fold
+    point itself to their first sample. `fixed`: the parameters held fixed, stated in the title.
 
     Each panel's Axes has gid `gamma1` or `gamma2`. Its marker collections have gids `stable`,
     `unstable`, `nonphysical` (when drawn) and one per event kind, offsets (param value, angle in
@@ -261,7 +313,7 @@ def bifurcation_figure(
         angle = f"{name}_deg"
         ax.set_gid(name)
         if has_branches:
-            _draw_lines(ax, rows, param, angle, rank_of, colour_of)
+            _draw_lines(ax, rows, param, angle, rank_of, colour_of, events)
         _draw_markers(ax, rows, param, angle, dense, colour_of)
         _draw_events(ax, events, param, angle)
         ax.set_ylim(0, 360)
@@ -274,8 +326,27 @@ def bifurcation_figure(
         axes[1].set_xlim(values[0] - pad, values[-1] + pad)
     axes[1].set_xlabel(param_label(param))
     _legend(fig, has_branches, dense, show_all, events)
-    fig.suptitle(_title(sweep, param, values, has_branches), fontsize=10)
+    title = _title(sweep, param, values, has_branches)
+    fig.suptitle(title + _fixed_line(fixed, param), fontsize=10)
     return fig
+
+
+def _fixed_line(fixed: Mapping[str, float] | None, param: str) -> str:
+    """A second title line: the free lengths held fixed, then every other parameter that is not
+    Table 1's (the rest are said to be)."""
+    if not fixed:
+        return ""
+    names = [n for n in ("L01", "L02") if n in fixed and n != param]
+    names += [
+        n
+        for n in PARAM_NAMES
+        if n in fixed and n not in names and n != param and fixed[n] != TABLE1.get(n)
+    ]
+    items = ", ".join(f"{n} = {float(fixed[n]):g} {PARAM_UNITS.get(n, '')}".rstrip() for n in names)
+    listed = set(names) | {param}
+    rest = [n for n in PARAM_NAMES if n not in listed]
+    tail = "; the other parameters as in Table 1" if rest else ""
+    return f"\nfixed: {items}{tail}" if items else "\nfixed: every other parameter as in Table 1"
 
 
 def _title(sweep: pd.DataFrame, param: str, values: np.ndarray, has_branches: bool) -> str:
@@ -301,9 +372,11 @@ def plot_bifurcation(
     path: str | Path,
     show_all: bool = False,
     events: pd.DataFrame | None = None,
+    fixed: Mapping[str, float] | None = None,
 ) -> list[Path]:
     """gamma1 and gamma2 against `param` in one two-panel figure (see bifurcation_figure).
 
     Writes `<path>.png` and `<path>.svg`, or only `path` if it ends in .png, .svg or .pdf.
     """
-    return save(bifurcation_figure(sweep, param, show_all=show_all, events=events), path)
+    figure = bifurcation_figure(sweep, param, show_all=show_all, events=events, fixed=fixed)
+    return save(figure, path)

@@ -12,6 +12,9 @@
 3. One solve end to end: `cotm-bertini solve case3 --no-cache --no-plots` as a subprocess,
    median of 5, with the import times of its heavy modules (python -X importtime).
 4. `--profile`: cProfile of continued sweep points (the top functions).
+6. `--map`: issue 17's map goal: the `make map` command (101 x 101 direct solves over
+   [0, 14]^2, fold curves, figures) end to end, with its split (fold curves, the 2-D sweep's
+   solving and finishing, the rest) and the CPU time of it and its workers.
 5. `--ratios`: issue 17's yardstick, in one run: the CLI sweep of the paper (241 points, 2
    workers, no figures) and the cold `solve case3 --no-cache --no-plots`, each interleaved with a
    bare `bertini2` case-2 solve (total degree, 48 paths), median of `--repeats`; the sweep's time
@@ -20,6 +23,7 @@
 
 Benchmarks, not tests: nothing is asserted; targets are printed beside the measurements.
 Usage: .venv/bin/python bench/speed.py [--grid] [--profile] [--sample 8] [--ratios [--repeats 5]]
+       [--map]
 """
 
 from __future__ import annotations
@@ -42,6 +46,9 @@ TARGET_SOLVE_S = 0.3
 TARGET_SWEEP_RATIO = 1.6  # issue 17: the CLI sweep in <= 1.6 bare bertini2 case-2 solves
 TARGET_OUTSIDE = 0.2  # ... with at most 20 % of it outside solving
 TARGET_SOLVE_RATIO = 0.3  # the cold solve in <= 0.3 bare bertini2 case-2 solves
+TARGET_MAP_S = 60.0  # issue 17: `make map` (101 x 101) end to end
+# The Makefile's `make map`.
+MAP_ARGS = "map --param L01 --from 0 --to 14 --param2 L02 --from2 0 --to2 14 --points 101".split()
 
 
 def sweep_values(n: int) -> np.ndarray:
@@ -382,6 +389,47 @@ def ratios(repeats: int = 5) -> dict:
     return out
 
 
+def make_map() -> dict:
+    """Section 6: `make map` end to end in a fresh cache of sweeps (the generic sets and the
+    compiled equations kept), its split, and the CPU seconds of it and its workers."""
+    import json
+    import os
+    import resource
+    import shutil
+
+    from cotm_bertini.fs import cache_root
+
+    shutil.rmtree(cache_root() / "sweeps", ignore_errors=True)  # solve every point again
+    exe = str(Path(sys.executable).with_name("cotm-bertini"))
+    load = os.getloadavg()[0]
+    with tempfile.TemporaryDirectory(prefix="bench-map-") as tmp:
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+        start = time.perf_counter()
+        subprocess.run([exe, *MAP_ARGS, "--out", tmp], capture_output=True, check=False)
+        wall = time.perf_counter() - start
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        folder = next(p for p in Path(tmp).iterdir() if p.is_dir() and p.name != "latest")
+        record = json.loads((folder / "run.json").read_text())
+        sweep = json.loads((folder / record["sweep_folder"] / "run.json").read_text())
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    t = record["timings"]
+    out = {
+        "make map, end to end (s)": wall,
+        "  fold curves and their proof (s)": t["folds"],
+        "  2-D sweep: solving 10,201 points (s)": sweep["timings"]["solve"],
+        "  2-D sweep: finishing (sweep.csv) (s)": sweep["timings"]["finish"],
+        "  the rest: start-up, counts, figures, files (s)": wall - t["folds"] - t["regions"],
+        "CPU seconds (all processes)": cpu,
+        "ms of CPU a point": 1e3 * cpu / 10201,
+        "methods (rows)": "; ".join(f"{k}: {v}" for k, v in sweep["methods"].items()),
+        "status": sweep["status"],
+        "load average (1 min) before, after": f"{load:.2f}, {os.getloadavg()[0]:.2f}",
+    }
+    show(f"6. make map, 101 x 101 (target {TARGET_MAP_S:.0f} s)",
+         pd.DataFrame([out]).T.reset_index().set_axis(["what", "value"], axis=1))  # fmt: skip
+    return out
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--grid", action="store_true", help="also the 101 x 101 grid (~2 min)")
@@ -389,9 +437,13 @@ def main() -> None:
     ap.add_argument("--sample", type=int, default=8, help="points timed for the peers")
     ap.add_argument("--ratios", action="store_true", help="only section 5 (issue 17 ratios)")
     ap.add_argument("--repeats", type=int, default=5, help="repeats of section 5")
+    ap.add_argument("--map", action="store_true", help="only section 6 (make map, ~3 min)")
     args = ap.parse_args()
-    if args.ratios:
-        ratios(args.repeats)
+    if args.ratios or args.map:
+        if args.ratios:
+            ratios(args.repeats)
+        if args.map:
+            make_map()
         return
     table = series(args.sample)
     show("1. The paper's sweep by four routes (2 cores)", table.drop(columns=["methods"]),

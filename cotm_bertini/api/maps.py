@@ -88,7 +88,7 @@ def design_map(
     xs, ys = grid_values(*l01, points), grid_values(*l02, points)
     sw = sweep(params, "L01", xs, settings, param2="L02", values2=ys, workers=workers,
                progress=progress)  # fmt: skip
-    regions = _counts(sw.table, xs, ys)
+    regions = _counts(sw.columns, xs, ys)
     pieces = int(folds.curve_id[folds.curve_id >= 0].nunique())
     record = {
         "params": params.as_dict(), "window": {"L01": list(l01), "L02": list(l02)},
@@ -110,10 +110,16 @@ def grid_values(lo: float, hi: float, points: int) -> np.ndarray:
     return np.array([float(a + (b - a) * k / (points - 1)) for k in range(points)])
 
 
-def _counts(table: pd.DataFrame, xs: np.ndarray, ys: np.ndarray) -> pd.DataFrame:
-    """Physical and stable equilibria at each grid point (0 where a point has no row)."""
-    t = table.assign(physical=table.physical.astype(bool), stable=table.stable.astype(bool))
-    counts = t.groupby(["L01", "L02"], sort=True)[["physical", "stable"]].sum()
-    full = pd.MultiIndex.from_product([xs, ys], names=["L01", "L02"])
-    counts = counts.reindex(full, fill_value=0)
-    return counts.reset_index().astype({"physical": int, "stable": int})
+def _counts(columns: dict[str, np.ndarray], xs: np.ndarray, ys: np.ndarray) -> pd.DataFrame:
+    """Physical and stable equilibria at each grid point (0 where a point has no row), from the
+    2-D sweep's columns (its `point` is the grid index, L02 varying fastest)."""
+    size = len(xs) * len(ys)
+    point = np.asarray(columns["point"], dtype=int)
+    count = {
+        name: np.bincount(point, weights=np.asarray(columns[name], dtype=bool), minlength=size)
+        for name in ("physical", "stable")
+    }
+    return pd.DataFrame(
+        {"L01": np.repeat(xs, len(ys)), "L02": np.tile(ys, len(xs)),
+         **{name: c.astype(int) for name, c in count.items()}}
+    )  # fmt: skip

@@ -44,6 +44,14 @@ class Sweep:
         return self._table
 
     @property
+    def columns(self) -> dict:
+        """The table as numpy columns (no DataFrame built when the sweep has just run)."""
+        if self._columns is not None:
+            return self._columns
+        table = self.table
+        return {name: table[name].to_numpy() for name in table.columns}
+
+    @property
     def events(self):
         """Folds, pitchforks, stability and physical changes, refined (events.csv)."""
         if self._events is None:

@@ -5,9 +5,10 @@ sum_i k_i (1 - L0_i/d_i) a_i: a critical point of V is relaxed (d_i = L0_i for b
 lies on the parallel curve C = {f = 0}, f = a_1 x a_2 (docs/design.md). C does not depend on the
 free lengths. This module covers C by boxes ("leaves") in each of which C is proved to be the
 graph of a function of one angle: a quadtree over the torus drops every box where the enclosure
-of f excludes 0 and keeps, as a leaf, every box where that of df/dgamma2 (C a graph over gamma1)
-or of df/dgamma1 (over gamma2) excludes 0. Every point of C lies in a leaf (or in one of the
-`undecided` boxes, where neither test succeeded at the smallest size: near a singular point of C).
+of f (or its mean value form about the box's midpoint) excludes 0 and keeps, as a leaf, every
+box where that of df/dgamma2 (C a graph over gamma1) or of df/dgamma1 (over gamma2) excludes 0.
+Every point of C lies in a leaf (or in one of the `undecided` boxes, where neither test
+succeeded at the smallest size: near a singular point of C).
 
 Boxes are index ranges on an increasing grid of angles per axis, so that a leaf's edges lie on
 grid lines (the sampled lines of `fold_curves`, for the map's certificate).
@@ -16,6 +17,7 @@ grid lines (the sampled lines of `fold_curves`, for the map's certificate).
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -123,7 +125,8 @@ def curve_cover(
     start: int = 16,
 ) -> Cover:  # fmt: skip
     """The quadtree on the grid `edges1` x `edges2` (increasing angles, rad, spanning 2 pi):
-    leaves no wider than `max_cells` grid cells (if given), smallest box one cell."""
+    boxes where f excludes 0 (by its enclosure or its mean value form) dropped, leaves no wider
+    than `max_cells` grid cells (if given), smallest box one cell."""
     cover = Cover()
     cuts1, cuts2 = _start(len(edges1) - 1, start), _start(len(edges2) - 1, start)
     stack = [(a, b, c, d) for a, b in zip(cuts1[:-1], cuts1[1:], strict=True)
@@ -133,9 +136,9 @@ def curve_cover(
         i0, i1, j0, j1 = stack.pop()
         cover.boxes += 1
         q = (float(edges1[i0]), float(edges1[i1]), float(edges2[j0]), float(edges2[j1]))
-        parts = spring_parts(sp, interval(q[0], q[1]), interval(q[2], q[3]), second=True)
-        f, fx, fy = cross_and_slopes(parts)
-        if f > 0 or f < 0:
+        g1, g2 = interval(q[0], q[1]), interval(q[2], q[3])
+        f, fx, fy = cross_and_slopes(spring_parts(sp, g1, g2, second=True))
+        if f > 0 or f < 0 or _misses_curve(sp, q, g1, g2, fx, fy):
             continue
         small = i1 - i0 <= cap and j1 - j0 <= cap
         if small and (fy > 0 or fy < 0 or fx > 0 or fx < 0):
@@ -148,6 +151,15 @@ def curve_cover(
             continue
         stack.extend(_halves((i0, i1, j0, j1)))
     return cover
+
+
+def _misses_curve(sp: Springs, q: tuple, g1, g2, fx, fy) -> bool:
+    """Whether the mean value form f(m) + f_x (g1 - m1) + f_y (g2 - m2) (m the box's midpoint)
+    excludes 0: tighter than f's own enclosure where a_1 and a_2 are both small (f is then a
+    difference of products of small quantities)."""
+    m1, m2 = 0.5 * (q[0] + q[1]), 0.5 * (q[2] + q[3])
+    value = cross(spring_parts(sp, arb(m1), arb(m2))) + fx * (g1 - m1) + fy * (g2 - m2)
+    return value > 0 or value < 0
 
 
 def _axis(fx, fy) -> int:
@@ -270,8 +282,6 @@ def certify_samples(params: Params, samples: list, grid: np.ndarray,
     grid lines), every crossing of a leaf edge isolated, and each one found among the samples.
     Crossings the samples lack are added (bisected in double precision). Returns the run.json
     `certificate` record and the samples with any additions."""
-    import time
-
     from ..versions import dist_version
 
     start = time.perf_counter()
@@ -282,7 +292,8 @@ def certify_samples(params: Params, samples: list, grid: np.ndarray,
     samples, added = _add_missing(params, samples, grid, found)
     proved = not cover.undecided and not found.undecided
     crossings = len(found.lines[0]) + len(found.lines[1])
-    cells = f"{max_cells} x {max_cells} sampling cells ({math.degrees(max_cells * (grid[1] - grid[0])):.2f} deg)"  # noqa: E501
+    size = math.degrees(max_cells * (grid[1] - grid[0]))
+    cells = f"{max_cells} x {max_cells} sampling cells ({size:.2f} deg)"
     statement = (
         f"proved: the parallel curve lies in {len(cover.leaves)} boxes of at most {cells}, in "
         f"each the graph of a function of one angle; each of its {crossings} crossings of "

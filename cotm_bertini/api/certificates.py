@@ -8,7 +8,8 @@ from .solutions import Solutions
 
 def certify(res: Solutions, strict: bool = True):
     """Prove every reported solution (Krawczyk, ball arithmetic) and that no physical
-    equilibrium is missing (branch and bound over the torus); docs/certify.md says what exactly.
+    equilibrium is missing (the relaxed ones by branch and bound, the others along the parallel
+    curve a1 x a2 = 0, enclosed in ball arithmetic); docs/certify.md says what exactly.
 
     Returns the Certificate and attaches it to `res` (`res.certificate`; `res.table` gains the
     columns `certified` and `certified_radius`; `res.save` writes them and a `certificate` block

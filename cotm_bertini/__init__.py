@@ -16,6 +16,7 @@ from ._version import __version__
 
 _EXPORTS = {
     "Params": "cotm_bertini.params",
+    "Framework": "cotm_bertini.model.framework.spec",
     "Settings": "cotm_bertini.settings",
     "Tolerances": "cotm_bertini.settings",
     "Solutions": "cotm_bertini.api.solutions",

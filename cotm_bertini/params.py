@@ -122,6 +122,14 @@ class Params:
         """Parameters as a plain dict, in PARAM_NAMES order."""
         return {name: getattr(self, name) for name in PARAM_NAMES}
 
+    def key_fields(self) -> dict:
+        """What a cached solve of these parameters depends on (the cache key's model part)."""
+        return self.as_dict()
+
+    def record_fields(self) -> dict:
+        """The model's entries of run.json besides the parameter values."""
+        return {"zero_free_length": {"spring1": self.zfl[0], "spring2": self.zfl[1]}}
+
     def replace(self, **values: float) -> Params:
         """A copy with some values replaced, validated like the command line."""
         return make_params(None, {**self.as_dict(), **values})

@@ -198,6 +198,8 @@ def solve_framework_point(
     """Every equilibrium of a framework (cb.Framework): each taut set of its cables solved by
     the parameter homotopy, classified, checked for completeness, in one table."""
     from .analysis.framework_checks import completeness, framework_counts, order_rows
+    from .model.framework.compiled import framework_system
+    from .model.framework.derive import check_mobility
     from .model.framework.units import normalized_slots, units
 
     if settings.engine != "homotopy":
@@ -206,6 +208,9 @@ def solve_framework_point(
             "engine (engine='homotopy')"
         )
     t = Timings()
+    with t.stage("derive"):
+        # Free even with every cable taut: a continuum of equilibria, refused as bad input.
+        check_mobility(fw, framework_system(fw, tuple(c.name for c in fw.cables)))
     unit = units(fw)
     target, centre = normalized_slots(fw), normalized_slots(fw.at_defaults())
     parts, report, texts = [], {}, []

@@ -23,6 +23,7 @@ from ..io.runfolder import (
     summary_head,
     write_solution_files,
 )
+from ..model.framework.spec import Framework
 from ..params import Params
 from ..settings import Settings, Tolerances
 
@@ -166,7 +167,7 @@ class Solutions:
 
 
 def solve(
-    params: Params,
+    params: Params | Framework,
     settings: Settings | None = None,
     *,
     cache: bool = True,
@@ -174,7 +175,8 @@ def solve(
     label: str = "",
     **options,
 ) -> Solutions:
-    """Every equilibrium of `params`: all finite solutions, classified real, physical, stable.
+    """Every equilibrium of `params` (the paper's mechanism, or a cb.Framework): all finite
+    solutions, classified real, physical, stable.
 
     Options are Settings fields (seed, engine, mptype, final_tol, timeout, threads, ...), each
     honoured or refused with ParameterError. An identical earlier request is answered from the
@@ -186,7 +188,7 @@ def solve(
     start = time.perf_counter()
     settings = (settings or Settings()).replace(**options)
     tol = _tolerances(tolerances)
-    key = solve_cache.request_key(params.as_dict(), settings.result_key(), tol)
+    key = solve_cache.request_key(params.key_fields(), settings.result_key(), tol)
     if cache:
         hit = solve_cache.lookup(key)
         if hit is not None:
@@ -213,10 +215,12 @@ def solve(
 
 
 def _solve_in(work: Path, params: Params, settings: Settings, tol: dict, label: str):
-    from ..point import solve_point
+    from ..point import solve_framework_point, solve_point
 
     start = time.perf_counter()
     try:
+        if not isinstance(params, Params):
+            return solve_framework_point(params, settings, Tolerances(**tol))
         return solve_point(params, settings, Tolerances(**tol), folder=work, title=label)
     except (CotmError, KeyboardInterrupt) as exc:
         failed = temp_folder("cotm-failed-")

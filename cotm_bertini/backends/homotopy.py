@@ -35,6 +35,7 @@ from .render import render_parameter_homotopy, render_system
 _SUCCESS = "Success"
 DOUBLE_FINAL_TOLERANCE = 1e-8
 DOUBLE_MAX_STEPS = 2000
+GENERIC_MAX_STEPS = 20000  # steps a path of a framework's generic solve may take
 SECOND_START = 7919  # seed offset of the independent second generic set
 SECONDS_PER_PATH = 0.06  # an ab-initio path of the generic solve (case 3: 192 paths, ~12 s)
 ANNOUNCE_SECONDS = 2.0  # a generic solve expected to take longer is announced on stderr
@@ -188,15 +189,14 @@ def _announce(ps: ParametricSystem, seed: int, stored: Path | None, groups=None)
     """One line on stderr before a generic solve long enough to be noticed: what, how long."""
     paths = ps.instantiate([1.0 + 0.1j * k for k in range(len(ps.parameters))]).total_degree
     seconds = paths * SECONDS_PER_PATH
-    if groups:  # a multihomogeneous start has fewer paths than the total degree: a bound
-        paths, seconds = f"at most {paths}", f"up to {seconds:.0f}"
     if seconds < ANNOUNCE_SECONDS:
         return
+    # A multihomogeneous start (groups) has fewer paths than the total degree: a bound.
+    bound = "at most " if groups else ""
     where = f"once: kept in {stored} for every later solve" if stored else "not cached"
     print(
         f"cotm-bertini: solving the generic solution set of these equations for seed {seed} "
-        f"({paths} paths, roughly {seconds if isinstance(seconds, str) else f'{seconds:.0f}'} s;"
-        f" {where})",
+        f"({bound}{paths} paths, {'up to' if groups else 'roughly'} {seconds:.0f} s; {where})",
         file=sys.stderr,
         flush=True,
     )
@@ -217,6 +217,10 @@ def _solve_generic(
     bertini.random.set_random_seed(seed)
     t0 = time.perf_counter()
     solver = na.ZeroDimSolver(bertini.parse.system(render_system(system, groups)))
+    if groups:
+        # A framework's start system can send a few paths crawling for ever; a path cut short
+        # shows up as a count the second generic set (another seed) does not confirm.
+        solver.set(max_num_steps=GENERIC_MAX_STEPS)
     solver.solve(show_progress=True)  # a bar on a terminal after 5 s; silent otherwise
     seconds = time.perf_counter() - t0
     meta, pts = solver.solution_metadata(), solver.all_solutions()

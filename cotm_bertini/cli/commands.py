@@ -251,9 +251,13 @@ def paper(args: argparse.Namespace) -> int:
 
 def params(args: argparse.Namespace) -> int:
     """`params`: the parameter set a command line describes (Table 1 by default), as TOML."""
-    from ..params import PARAM_MEANING, PARAM_UNITS
+    from ..params import PARAM_MEANING, PARAM_UNITS, Params
 
     p = params_from(args)  # exactly the set `solve` would solve
+    if not isinstance(p, Params):
+        for name, value in p.as_dict().items():
+            print(f"{name} = {value!r}")
+        return EXIT_OK
     for name, value in p.as_dict().items():
         print(f"{name} = {value!r}  # {PARAM_UNITS[name]}, {PARAM_MEANING[name]}")
     return EXIT_OK

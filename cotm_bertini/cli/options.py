@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..errors import ParameterError
 from ..params import (
     CASES,
     PARAM_NAMES,
@@ -51,7 +52,13 @@ def add_case(p: argparse.ArgumentParser, default: str = NO_CASE) -> None:
 
 
 def add_params(p: argparse.ArgumentParser) -> None:
-    """--params FILE and --set NAME=VALUE."""
+    """--framework FILE, --params FILE and --set NAME=VALUE."""
+    p.add_argument(
+        "--framework",
+        metavar="FILE.toml",
+        help="solve your own mechanism: a framework file (docs/frameworks.md, examples/); "
+        "--set then sets its [parameters]",
+    )
     p.add_argument(
         "--params",
         metavar="FILE.toml",
@@ -105,15 +112,46 @@ def overrides(args: argparse.Namespace) -> dict[str, float]:
     return values
 
 
-def params_from(args: argparse.Namespace) -> Params:
+# The commands that take --framework; the others refuse it (the paper's mechanism only, so far).
+FRAMEWORK_COMMANDS = ("solve", "params")
+
+
+def params_from(args: argparse.Namespace):
     """The parameters a command line asks for: Table 1, the case, the file, the --set's (every
-    command, `params` included, reads them here)."""
+    command, `params` included, reads them here); with --framework, that framework with its
+    [parameters] and the --set's."""
+    if getattr(args, "framework", None):
+        return framework_from(args)
     return make_params(getattr(args, "case", None), overrides(args))
 
 
-def describe(params: Params) -> str:
-    """The free lengths a command used, and every other value that is not Table 1's."""
+def framework_from(args: argparse.Namespace):
+    """The framework of --framework with each --set NAME=VALUE applied to its parameters."""
+    from ..model.framework.spec import Framework
+
+    if args.command not in FRAMEWORK_COMMANDS:
+        raise ParameterError(
+            f"--framework: `{args.command}` works on the paper's mechanism only so far "
+            f"(frameworks: {', '.join(FRAMEWORK_COMMANDS)})"
+        )
+    if getattr(args, "case", None) or args.params:
+        raise ParameterError("--framework: a case or --params describes the paper's mechanism")
+    fw = Framework.from_toml(args.framework)
+    values = {}
+    for text in args.set:
+        name, sep, value = text.partition("=")
+        if not sep:
+            raise ParameterError(f"--set {text!r}: expected NAME=VALUE")
+        values[name.strip()] = value.strip()
+    return fw.replace(**values)
+
+
+def describe(params) -> str:
+    """The free lengths a command used, and every other value that is not Table 1's (for a
+    framework: its parameter values)."""
     values = params.as_dict()
+    if not isinstance(params, Params):
+        return ", ".join(f"{n} = {v:.12g}" for n, v in values.items()) or "no parameters"
     free = [f"{n} = {values[n]:.12g} {PARAM_UNITS[n]}" for n in ("L01", "L02")]
     changed = [
         f"{n} = {v:.12g} {PARAM_UNITS[n]}"
@@ -125,6 +163,8 @@ def describe(params: Params) -> str:
 
 def label_of(args: argparse.Namespace) -> str:
     """A run's label: the case named, else the parameter file's name, else `custom` for --set."""
+    if getattr(args, "framework", None):
+        return Path(args.framework).stem
     if args.case:
         return args.case
     if args.params:

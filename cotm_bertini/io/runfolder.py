@@ -41,7 +41,7 @@ def solve_record(point: PointSolution, tolerances: dict, label: str, key: str | 
         "status": point.status,
         "warnings": list(point.warnings),
         "parameters": p.as_dict(),
-        "zero_free_length": {"spring1": p.zfl[0], "spring2": p.zfl[1]},
+        **p.record_fields(),
         "settings": point.settings.as_dict(),
         "seed": point.settings.seed,
         "tolerances": tolerances,
@@ -84,21 +84,35 @@ def summary_text(record: dict, table: dict) -> str:
     return "\n".join(lines)
 
 
+def summary_columns(table: dict) -> list[str]:
+    """The columns the console shows: the paper's, or for a framework its pose columns (angles,
+    quaternions, then node coordinates; at most six) with energy and classification."""
+    if all(n in table for n in SUMMARY_COLUMNS):
+        return SUMMARY_COLUMNS
+    parts = [n.split(".") for n in table if n.count(".") == 1]
+    oriented = {p[0] for p in parts if p[1] in ("angle_deg", "qw")}
+    pose = [".".join(p) for p in parts if p[1] in ("angle_deg", "qw", "qx", "qy", "qz")]
+    # Entities with no orientation are nodes: their coordinates are their pose.
+    pose += [".".join(p) for p in parts if p[1] in ("x", "y", "z") and p[0] not in oriented]
+    return ["solution_id", *pose[:6], "energy", "physical", "stable", "kind", "reason"]
+
+
 def _real_rows_text(table: dict, rows: list[int]) -> str:
     """The real solutions as an aligned text table (angles wrapped after rounding to 4 digits,
     so 359.99996 prints as 0.0000, not 360.0000)."""
 
     def fmt(name: str, value) -> str:
         if isinstance(value, float):
-            if name.startswith("gamma"):
+            if name.startswith("gamma") or name.endswith("angle_deg"):
                 value = round(value, 4) % 360.0
             return f"{value:.4f}"
         return str(value)
 
+    names = summary_columns(table)
     cells = [[fmt(n, table[n][k].item() if hasattr(table[n][k], "item") else table[n][k])
-              for n in SUMMARY_COLUMNS] for k in rows]  # fmt: skip
-    widths = [max(len(n), *(len(r[j]) for r in cells)) for j, n in enumerate(SUMMARY_COLUMNS)]
-    head = " ".join(n.rjust(w) for n, w in zip(SUMMARY_COLUMNS, widths, strict=True))
+              for n in names] for k in rows]  # fmt: skip
+    widths = [max(len(n), *(len(r[j]) for r in cells)) for j, n in enumerate(names)]
+    head = " ".join(n.rjust(w) for n, w in zip(names, widths, strict=True))
     body = [" ".join(c.rjust(w) for c, w in zip(r, widths, strict=True)) for r in cells]
     return "\n".join([head, *body])
 

@@ -12,8 +12,13 @@ from .energy_map import plot_energy_map
 
 
 def plot_run(params: Params, solutions: pd.DataFrame, folder: str | Path) -> list[Path]:
-    """Both figures into a run folder: configurations.{png,svg} and energy_map.{png,svg}."""
+    """Both figures into a run folder: configurations.{png,svg} and energy_map.{png,svg}; for a
+    framework its configurations."""
     folder = Path(folder)
+    if not isinstance(params, Params):
+        from .framework import plot_framework
+
+        return plot_framework(params, solutions, folder / "configurations")
     return plot_configurations(params, solutions, folder / "configurations") + plot_energy_map(
         params, solutions, folder / "energy_map"
     )

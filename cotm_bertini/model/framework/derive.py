@@ -231,6 +231,8 @@ def derive(fw: Framework, taut: tuple[str, ...]) -> Derived:
     descriptions = about + law_about
     variables = config + extra
     free = [descriptions[i] for i, f in enumerate(equations) if f == 0]
+    if not _active(fw, taut) and not fw.loads:
+        free.insert(0, "any motion (no spring, taut cable or load acts)")
     slots = [n for n in fw.slots()]
     ps = parametric_from_sympy(
         tuple(variables), tuple(f"f{i + 1}" for i in range(len(equations))),
@@ -391,8 +393,9 @@ def structure_key(fw: Framework, taut: tuple[str, ...]) -> str:
     return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
 
-def check_mobility(fw: Framework, derived: Derived) -> None:
-    """Refuse a framework that moves freely with every cable taut (a continuum of equilibria)."""
+def check_mobility(fw: Framework, derived) -> None:
+    """Refuse a framework that moves freely with every cable taut (a continuum of equilibria);
+    `derived`: a Derived or a FrameworkSystem (both list the free directions)."""
     if derived.free:
         raise ParameterError(
             f"framework {fw.name!r} can move freely: nothing resists {derived.free[0]} "

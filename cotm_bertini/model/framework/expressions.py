@@ -125,8 +125,9 @@ class _Parser:
             return Expr("name", name=text)
         if text == "(":
             inner = self.sum()
-            if self.take() != ("sym", ")"):
+            if self.peek() != ("sym", ")"):
                 raise self.fail("a '(' is not closed")
+            self.take()
             return inner
         raise self.fail(f"unexpected {text!r}")
 

@@ -65,5 +65,8 @@ def cable_states(fw: Framework) -> dict[str, str]:
     for cable in fw.cables:
         lo, hi = length_bounds(fw, cable.a, cable.b)
         L0 = slots[f"L0_{cable.name}"]
-        out[cable.name] = "taut" if lo > L0 else ("slack" if hi < L0 else "either")
+        # A cable of zero free length pulls whenever its ends are apart: always taut (at d = 0
+        # both models give no force).
+        taut = lo > L0 or L0 == 0
+        out[cable.name] = "taut" if taut else ("slack" if hi < L0 else "either")
     return out

@@ -8,6 +8,7 @@ the slots only, so any parameter (and any expression of parameters) can be swept
 
 from __future__ import annotations
 
+import hashlib
 import math
 import re
 import tomllib
@@ -99,6 +100,28 @@ class Framework:
         out = replace(self, parameters=tuple(known.items()))
         check_values(out)
         return out
+
+    def as_dict(self) -> dict[str, float]:
+        """The parameter values (as Params.as_dict)."""
+        return self.values
+
+    def key_fields(self) -> dict:
+        """What a cached solve depends on: the whole description and the values."""
+        blob = repr(replace(self, source="", defaults=()))
+        return {"framework": hashlib.sha256(blob.encode()).hexdigest(), **self.values}
+
+    def record_fields(self) -> dict:
+        """The framework's entries of run.json besides the parameter values."""
+        return {
+            "framework": {
+                "name": self.name, "source": self.source, "dim": self.dim,
+                "bodies": [b for b, _ in self.bodies], "nodes": list(self.nodes),
+                "pins": len(self.pins), "springs": [x.name for x in self.springs],
+                "cables": [x.name for x in self.cables], "bars": [x.name for x in self.bars],
+                "loads": [x.name for x in self.loads], "slots": self.slots(),
+            },
+            "zero_free_length": list(self.zero_free_length()),
+        }  # fmt: skip
 
     @property
     def springs(self) -> tuple[Link, ...]:

@@ -1,0 +1,79 @@
+"""Pictures of a framework's equilibria: every physical one drawn in its pose."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from matplotlib.figure import Figure
+
+from ..model.framework.spec import Framework, owner
+from .common import physical_rows, save
+
+_AXES = "xyz"
+_STYLE = {
+    "spring": {"color": "tab:blue", "lw": 1.4},
+    "cable": {"color": "tab:green", "lw": 1.0, "ls": "--"},
+    "bar": {"color": "black", "lw": 3.0},
+}
+
+
+def _point(fw: Framework, row: pd.Series, name: str) -> np.ndarray:
+    """A point's world coordinates in this row (ground points from the framework's values)."""
+    dims = range(fw.dim)
+    if owner(name) == "ground":
+        slots = fw.slots()
+        return np.array([slots[f"g_{name.split('.', 1)[1]}_{_AXES[a]}"] for a in dims])
+    return np.array([row[f"{name}.{_AXES[a]}"] for a in dims])
+
+
+def _draw(ax, fw: Framework, row: pd.Series) -> None:
+    def line(a, b, **style):
+        pts = np.array([_point(fw, row, a), _point(fw, row, b)]).T
+        ax.plot(*pts, **style)
+
+    for body, pts in fw.bodies:
+        xy = np.array([_point(fw, row, f"{body}.{p}") for p, _ in pts])
+        closed = np.vstack([xy, xy[:1]]).T
+        ax.plot(*closed, color="tab:orange", lw=2.2)
+    for x in fw.links:
+        style = dict(_STYLE[x.kind])
+        if x.kind == "cable" and not bool(row.get(f"{x.name}.taut", True)):
+            style.update(color="0.6", ls=":")
+        line(x.a, x.b, **style)
+    for a, _ in fw.pins:
+        ax.scatter(*_point(fw, row, a), s=18, color="white", edgecolor="black", zorder=5)
+    ground = np.array([_point(fw, row, f"ground.{g}") for g, _ in fw.ground])
+    if len(ground):
+        ax.scatter(*ground.T, marker="^", s=30, color="0.3", zorder=4)
+    for node in fw.nodes:
+        ax.scatter(*_point(fw, row, node), s=14, color="black", zorder=5)
+
+
+def plot_framework(fw: Framework, solutions: pd.DataFrame, path: str | Path) -> list[Path]:
+    """configurations.{png,svg}: one panel per physical equilibrium, stable ones marked."""
+    rows = physical_rows(solutions)
+    n = max(len(rows), 1)
+    cols = min(4, n)
+    nrows = math.ceil(n / cols)
+    fig = Figure(figsize=(3.2 * cols, 3.0 * nrows + 0.6))
+    kw = {"projection": "3d"} if fw.dim == 3 else {}
+    for k, (_, row) in enumerate(rows.iterrows()):
+        ax = fig.add_subplot(nrows, cols, k + 1, **kw)
+        _draw(ax, fw, row)
+        if fw.dim == 2:
+            ax.set_aspect("equal", adjustable="datalim")
+        mark = "stable" if bool(row["stable"]) else str(row["kind"])
+        ax.set_title(f"#{int(row['solution_id'])}: {mark}, V = {row['energy']:.4g}", fontsize=9)
+        ax.tick_params(labelsize=7)
+    if not len(rows):
+        fig.add_subplot(1, 1, 1).text(0.5, 0.5, "no physical equilibrium", ha="center")
+    fig.suptitle(
+        f"{fw.name}: every physical equilibrium (orange: bodies, blue: springs, green dashed: "
+        "taut cables, grey dotted: slack, black: bars)",
+        fontsize=9,
+    )
+    fig.tight_layout()
+    return save(fig, path)

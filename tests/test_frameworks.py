@@ -1,0 +1,199 @@
+"""Frameworks from a file (issue 18): validation, and each example's equilibria against a route
+that shares no code with the solver (dense scans and local searches of an independent energy,
+the built-in paper model)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from conftest import ROOT
+from framework_physics import (
+    fourbar_branch,
+    fourbar_energy,
+    gradient_norm,
+    grid_minima,
+    pendulum_energy,
+    scan_critical_points,
+    zeeman_energy,
+)
+
+import cotm_bertini as cb
+from cotm_bertini.errors import ParameterError
+
+EXAMPLES = ROOT / "examples"
+
+
+def _angle_gap(a, b):
+    d = np.abs(np.mod(np.asarray(a) - np.asarray(b) + 180.0, 360.0) - 180.0)
+    return d
+
+
+def _match(found_deg, expected_deg, tol):
+    """Every expected angle has a found one within tol and the counts agree."""
+    found, expected = np.sort(np.asarray(found_deg)), np.sort(np.asarray(expected_deg))
+    assert len(found) == len(expected), (found, expected)
+    for e in expected:
+        assert _angle_gap(found, e).min() < tol, (e, found)
+
+
+@pytest.mark.parametrize("cables", [False, True])
+@pytest.mark.parametrize("u", [(0.1, -0.25), (1.45, 0.2), (0.6, 0.1)])
+def test_zeeman_against_a_dense_scan(cables, u):
+    name = "zeeman_cables" if cables else "zeeman"
+    fw = cb.Framework.from_toml(EXAMPLES / f"{name}.toml").replace(x=u[0], y=u[1])
+    res = cb.solve(fw)
+    assert res.status == "ok", res.warnings
+    crit = scan_critical_points(lambda t: zeeman_energy(t, u, cables))
+    phys = res.physical
+    _match(phys["wheel.angle_deg"], [np.degrees(t) for t, _ in crit], 1e-6)
+    mins = [np.degrees(t) for t, kind in crit if kind == "min"]
+    _match(res.stable["wheel.angle_deg"], mins, 1e-6)
+    assert set(phys["kind"]) <= {"min", "max"}
+
+
+def test_zeeman_cables_slack_band_is_reported():
+    # u close to the wheel: band_u can go slack, so two taut sets are solved.
+    fw = cb.Framework.from_toml(EXAMPLES / "zeeman_cables.toml").replace(x=1.45, y=0.2)
+    res = cb.solve(fw)
+    assert res.counts["taut_sets_solved"] == 2
+    phys = res.physical
+    slack = phys[~phys["band_u.taut"].astype(bool)]
+    assert len(slack), "expected an equilibrium with band_u slack"
+    assert (slack["band_u.length"] <= 0.25 + 1e-9).all()
+    assert (slack["band_u.tension"] == 0).all()
+
+
+def _cotm_rows(table):
+    return np.stack([table["rod.angle_deg"], table["top.angle_deg"]], axis=1)
+
+
+def _paper_rows(table):
+    return np.stack([table["gamma1_deg"], table["gamma2_deg"]], axis=1)
+
+
+def _same_poses(a, b, tol):
+    assert len(a) == len(b), (a, b)
+    for row in b:
+        assert _angle_gap(a, row).max(axis=1).min() < tol, (row, a)
+
+
+@pytest.mark.parametrize("case", ["case1", "case2", "case3"])
+def test_cotm_framework_equals_the_built_in_model(case):
+    p = cb.Params.case(case)
+    fw = cb.Framework.from_toml(EXAMPLES / "cotm.toml").replace(L01=p.L01, L02=p.L02)
+    res, ref = cb.solve(fw), cb.solve(p)
+    assert res.status == "ok", res.warnings
+    _same_poses(_cotm_rows(res.physical), _paper_rows(ref.physical), 1e-9)
+    _same_poses(_cotm_rows(res.stable), _paper_rows(ref.stable), 1e-9)
+
+
+def test_cotm_framework_random_geometries():
+    rng = np.random.default_rng(2026)
+    for _ in range(3):
+        values = {"L01": rng.uniform(5, 14), "L02": rng.uniform(5, 14), "k2": rng.uniform(1, 5),
+                  "p5x": rng.uniform(-1, 1), "p6x": rng.uniform(3, 5)}  # fmt: skip
+        fw = cb.Framework.from_toml(EXAMPLES / "cotm.toml").replace(**values)
+        res, ref = cb.solve(fw), cb.solve(cb.Params().replace(**values))
+        _same_poses(_cotm_rows(res.physical), _paper_rows(ref.physical), 1e-9)
+        _same_poses(_cotm_rows(res.stable), _paper_rows(ref.stable), 1e-9)
+
+
+def test_double_pendulum_against_torus_search():
+    res = cb.solve(cb.Framework.from_toml(EXAMPLES / "double_pendulum.toml"))
+    assert res.status == "ok", res.warnings
+    assert res.morse["applicable"] and res.morse["ok"]
+    phys = res.physical
+    th = np.radians(np.stack([phys["link1.angle_deg"], phys["link2.angle_deg"]], axis=1))
+    for x in th:  # every reported equilibrium is critical for the independent energy
+        assert gradient_norm(pendulum_energy, x) < 1e-6
+    minima = np.degrees(np.array(grid_minima(pendulum_energy)))
+    stable = np.stack([res.stable["link1.angle_deg"], res.stable["link2.angle_deg"]], axis=1)
+    _same_poses(stable, minima, 1e-6)
+
+
+def _write(tmp_path, text: str):
+    path = tmp_path / "f.toml"
+    path.write_text(text)
+    return path
+
+
+BASE = """
+name = "t"
+[parameters]
+x = 1.0
+[ground]
+c = [0.0, 0.0]
+u = ["x", 1.0]
+[bodies.w]
+o = [0.0, 0.0]
+r = [1.0, 0.0]
+[[pins]]
+a = "w.o"
+b = "ground.c"
+[[springs]]
+a = "w.r"
+b = "ground.u"
+k = 1.0
+L0 = 0.5
+"""
+
+
+@pytest.mark.parametrize(
+    "edit, words",
+    [
+        (('b = "ground.u"', 'b = "ground.nowhere"'), ["springs.spring1.b", "ground.nowhere"]),
+        (("r = [1.0, 0.0]", "r = [1.0, 0.0, 2.0]"), ["bodies.w.r", "3 coordinates"]),
+        (('u = ["x", 1.0]', 'u = ["z", 1.0]'), ["ground.u", "'z'", "not defined"]),
+        (('u = ["x", 1.0]', 'u = ["x*(2", 1.0]'), ["ground.u", "not closed"]),
+        (('u = ["x", 1.0]', 'u = ["x $ 2", 1.0]'), ["ground.u", "'$'"]),
+        (("k = 1.0", "k = -1.0"), ["springs.spring1.k", "-1.0"]),
+        (('name = "t"', 'name = "t"\ndim = 4'), ["dim", "4"]),
+        (("L0 = 0.5\n", "L0 = 0.5\n[bodies.empty]\n"), ["bodies.empty", "at least one point"]),
+    ],
+)
+def test_bad_framework_files_name_the_element(tmp_path, edit, words):
+    text = BASE.replace(*edit)
+    assert text != BASE
+    with pytest.raises(ParameterError) as err:
+        cb.Framework.from_toml(_write(tmp_path, text))
+    message = str(err.value)
+    assert "\n" not in message
+    for word in words:
+        assert word in message, message
+
+
+def test_duplicate_names_are_refused(tmp_path):
+    text = BASE + '[[springs]]\nname = "spring1"\na = "w.r"\nb = "ground.c"\nk = 1.0\nL0 = 0.1\n'
+    with pytest.raises(ParameterError, match="spring1"):
+        cb.Framework.from_toml(_write(tmp_path, text))
+
+
+def test_a_framework_that_moves_freely_is_refused(tmp_path):
+    # The spring's far end is pinned at the wheel's centre line: nothing resists the rotation
+    # only if no element acts on the wheel; here the spring joins ground to ground's twin body.
+    text = BASE.replace('a = "w.r"\nb = "ground.u"', 'a = "w.o"\nb = "ground.u"')
+    fw = cb.Framework.from_toml(_write(tmp_path, text))
+    with pytest.raises(ParameterError, match="moves freely|can move freely"):
+        cb.solve(fw)
+
+
+def test_replace_refuses_unknown_parameters():
+    fw = cb.Framework.from_toml(EXAMPLES / "zeeman.toml")
+    with pytest.raises(ParameterError, match="nope"):
+        fw.replace(nope=1.0)
+
+
+def test_fourbar_against_a_scan_of_both_assembly_branches():
+    res = cb.solve(cb.Framework.from_toml(EXAMPLES / "fourbar.toml"))
+    assert not res.morse["applicable"]  # a closed loop: not a torus
+    phys = res.physical
+    for branch in (1, -1):
+        crit = scan_critical_points(lambda t, b=branch: fourbar_energy(t, b))
+        on = [
+            fourbar_branch(c, f) == branch
+            for c, f in zip(phys["crank.angle_deg"], phys["coupler.angle_deg"], strict=True)
+        ]
+        found = phys[np.array(on, dtype=bool)]
+        _match(found["crank.angle_deg"], [np.degrees(t) for t, _ in crit], 1e-6)
+        mins = [np.degrees(t) for t, kind in crit if kind == "min"]
+        _match(found[found["stable"].astype(bool)]["crank.angle_deg"], mins, 1e-6)

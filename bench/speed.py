@@ -23,7 +23,7 @@
 
 Benchmarks, not tests: nothing is asserted; targets are printed beside the measurements.
 Usage: .venv/bin/python bench/speed.py [--grid] [--profile] [--sample 8] [--ratios [--repeats 5]]
-       [--map]
+       [--map] [--all]
 """
 
 from __future__ import annotations
@@ -438,8 +438,9 @@ def main() -> None:
     ap.add_argument("--ratios", action="store_true", help="only section 5 (issue 17 ratios)")
     ap.add_argument("--repeats", type=int, default=5, help="repeats of section 5")
     ap.add_argument("--map", action="store_true", help="only section 6 (make map, ~3 min)")
+    ap.add_argument("--all", action="store_true", help="sections 1, 3, 5 and 6 in one run")
     args = ap.parse_args()
-    if args.ratios or args.map:
+    if (args.ratios or args.map) and not args.all:
         if args.ratios:
             ratios(args.repeats)
         if args.map:
@@ -457,6 +458,9 @@ def main() -> None:
         grid()
     if args.profile:
         profile_points()
+    if args.all:
+        ratios(args.repeats)
+        make_map()
 
 
 if __name__ == "__main__":

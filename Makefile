@@ -29,7 +29,7 @@ case1 case2 case3: $(STAMP)
 	$(CLI) solve $@ --engine cli
 
 test: $(STAMP) phcpack
-	$(BIN)/pytest -q
+	$(BIN)/pytest -q -m "not slow"
 
 verify: $(STAMP) phcpack
 	$(CLI) verify case1 && $(CLI) verify case2 && $(CLI) verify case3

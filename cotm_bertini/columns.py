@@ -157,6 +157,59 @@ COUNTS = {
 }
 
 
+FRAMEWORK = {
+    "solution_id": "1, 2, ...: physical rows first, then other real roots, then complex ones; "
+    "within each group by energy",
+    "BODY.x, BODY.y (BODY.z)": "world position of the origin of the body's own frame",
+    "BODY.angle_deg": "planar: the body's rotation (deg) in [0, 360)",
+    "BODY.qw, BODY.qx, BODY.qy, BODY.qz": "spatial: the body's rotation as a unit quaternion "
+    "(q and -q are one pose: the first non-zero component is positive)",
+    "BODY.POINT.x, .y (.z)": "world coordinates of each named point of each body",
+    "NODE.x, .y (.z)": "world coordinates of each node",
+    "NAME.length": "spring or cable: its length (the signed length unknown where it has a free "
+    "length, so negative on rows that are not physical); bar: its length",
+    "NAME.tension": "spring: k (d - L0), > 0 in tension; cable: the same when taut, 0 when "
+    "slack; bar: its force, > 0 in tension",
+    "NAME.taut": "cable: taut in the system this row solves (see taut_set)",
+    "energy": "V = sum k/2 (d - L0)^2 over springs + sum k/2 max(d - L0, 0)^2 over cables - "
+    "sum F . x over loads (real parts for complex rows)",
+    "is_real": "every unknown has |Im| < 1e-8 relative to 1 + |Re| (in the framework's units)",
+    "singular": "jacobian_condition > 1e12, or several path endpoints at this solution",
+    "physical": "real, every spring and cable with a free length has d > 0, and the taut set is "
+    "consistent (taut cables longer than L0, slack ones not)",
+    "stable": "physical and kind min",
+    "kind": "physical rows: min, saddle, max of V on the constraint set (Hessian of the "
+    "Lagrangian reduced to the constraints' tangent space), or degenerate (an eigenvalue within "
+    "1e-9 of 0 relative to the largest Hessian entry, a singular root, or a cable at its free "
+    "length)",
+    "index": "physical rows: the number of negative reduced-Hessian eigenvalues (-1 otherwise)",
+    "reason": "why a row is not physical: complex, negative_length:NAME, cable_pushes:NAME (a "
+    "taut cable shorter than L0), slack_cable_stretched:NAME (a slack one longer); empty if "
+    "physical",
+    "hess_min_eig": "the smallest reduced-Hessian eigenvalue (the framework's units)",
+    "max_imag": "the largest |Im| / (1 + |Re|) over the unknowns",
+    "residual": "max |f_i| of the polynomial system at the refined point (framework's units)",
+    "jacobian_condition": "condition number of the system's Jacobian at the refined point",
+    "multiplicity": "how many path endpoints reached this solution",
+    "taut_set": "the cables taut in the polynomial system that gave this row",
+    "paths": "the path numbers that reached it",
+}
+
+FRAMEWORK_COUNTS = {
+    "paths_tracked": "paths tracked over every taut set (the generic sets' finite nonsingular "
+    "roots)",
+    "generic_paths": "paths of the ab-initio generic solves (multihomogeneous start), one seed",
+    "finite_endpoints": "tracked paths that ended at a finite point",
+    "infinite_or_failed_paths": "tracked paths that went to infinity or failed",
+    "lost_paths": "failed paths that may have hidden a solution (the status is then incomplete)",
+    "distinct_solutions": "rows of solutions.csv",
+    "real, physical, stable, singular": "rows that are so",
+    "taut_sets_solved": "taut sets solved (cables always taut or never taut are not enumerated)",
+    "taut_sets_continuum": "taut sets where something moves freely (see details.taut_sets)",
+    "closed_form_endpoints": "0: a framework has no closed-form roots",
+}
+
+
 def markdown(title: str, columns: dict[str, str], head: str = "column") -> str:
     """A Markdown table of columns (or other names) and their meanings."""
     lines = [f"## {title}", "", f"| {head} | meaning |", "|---|---|"]
@@ -166,7 +219,7 @@ def markdown(title: str, columns: dict[str, str], head: str = "column") -> str:
 
 def reference(*tables: str, title: str = "Columns of the CSV files in this folder") -> str:
     """The column reference of a run folder: 'solutions', 'counts', 'sweep', 'events',
-    'barriers', 'folds', 'regions', 'design'."""
+    'barriers', 'folds', 'regions', 'design', 'framework', 'framework_counts'."""
     known = {
         "solutions": ("solutions.csv", SOLUTIONS),
         "counts": ("counts (run.json `counts`, `res.counts`)", COUNTS, "count"),
@@ -176,6 +229,8 @@ def reference(*tables: str, title: str = "Columns of the CSV files in this folde
         "folds": ("folds.csv (`cb.fold_curves`)", FOLDS),
         "regions": ("regions.csv", REGIONS),
         "design": ("the design CSV (`cotm-bertini design --out`)", DESIGN),
+        "framework": ("solutions.csv of a framework (`--framework`)", FRAMEWORK),
+        "framework_counts": ("counts of a framework solve", FRAMEWORK_COUNTS, "count"),
     }
     parts = [f"# {title}\n"]
     parts += [markdown(*known[t]) for t in tables]
@@ -193,5 +248,7 @@ def document() -> str:
         "folds",
         "regions",
         "design",
+        "framework",
+        "framework_counts",
         title="Columns of the CSV files",
     )

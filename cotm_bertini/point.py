@@ -193,10 +193,12 @@ def _cli(params: Params, settings: Settings, system, folder: Path, title: str, t
 
 
 def solve_framework_point(
-    fw, settings: Settings = Settings(), tolerances: Tolerances = Tolerances()
+    fw, settings: Settings = Settings(), tolerances: Tolerances = Tolerances(), warm=None
 ) -> PointSolution:
     """Every equilibrium of a framework (cb.Framework): each taut set of its cables solved by
-    the parameter homotopy, classified, checked for completeness, in one table."""
+    the parameter homotopy, classified, checked for completeness, in one table. `warm` (the
+    `warm` of a neighbouring point's solution: a start per taut set) lets a sweep continue each
+    taut set from that point by Newton (backends.target.solve_parameters)."""
     from .analysis.framework_checks import completeness, framework_counts, order_rows
     from .model.framework.compiled import framework_system
     from .model.framework.derive import check_mobility
@@ -213,9 +215,11 @@ def solve_framework_point(
         check_mobility(fw, framework_system(fw, tuple(c.name for c in fw.cables)))
     unit = units(fw)
     target, centre = normalized_slots(fw), normalized_slots(fw.at_defaults())
-    parts, report, texts = [], {}, []
+    parts, report, texts, starts = [], {}, [], {}
     for taut in taut_sets(fw):
-        part, info, text = _solve_taut_set(fw, taut, unit, target, centre, settings, tolerances, t)
+        part, info, text = _solve_taut_set(
+            fw, taut, unit, target, centre, settings, tolerances, t, (warm or {}, starts)
+        )
         report[" ".join(taut) or "none"] = info
         if part is not None:
             parts.append(part)
@@ -230,7 +234,7 @@ def solve_framework_point(
     shape = {"taut_sets": list(report), "units": {"length": unit[0], "stiffness": unit[1]}}
     return PointSolution(
         fw, settings, table, None, counts, checks["morse"], status, tuple(checks["warnings"]),
-        engine, shape, {"taut_sets": report}, "\n".join(texts), t.stages,
+        engine, shape, {"taut_sets": report}, "\n".join(texts), t.stages, starts,
     )  # fmt: skip
 
 
@@ -250,8 +254,9 @@ def taut_sets(fw) -> list[tuple[str, ...]]:
     return [tuple(sorted(always + c, key=order.index)) for c in subsets]
 
 
-def _solve_taut_set(fw, taut, unit, target, centre, settings, tolerances, t: Timings):
-    """One taut set: (its rows or None, what was done, the homotopy input text)."""
+def _solve_taut_set(fw, taut, unit, target, centre, settings, tolerances, t: Timings, warm):
+    """One taut set: (its rows or None, what was done, the homotopy input text). `warm`: (the
+    starts of a neighbouring point by system key, where this point's starts go)."""
     from .analysis.framework_checks import continuum_check
     from .analysis.framework_classify import framework_columns
     from .backends.target import solve_parameters
@@ -264,7 +269,11 @@ def _solve_taut_set(fw, taut, unit, target, centre, settings, tolerances, t: Tim
         # which matters only where every cable of the set can be slack at once.
         return None, continuum_check(fw, fs, unit), ""
     with t.stage("solve"):
-        hs = solve_parameters(fs.ps, target, centre, settings, variable_groups(fs))
+        hs = solve_parameters(
+            fs.ps, target, centre, settings, variable_groups(fs), warm[0].get(fs.key)
+        )
+    if hs.warm is not None:
+        warm[1][fs.key] = hs.warm
     with t.stage("classify"):
         part = framework_columns(fw, fs, hs.endpoints, unit, tolerances)
     info = {**hs.info, "variables": list(fs.ps.variables), "functions": len(fs.ps.names)}

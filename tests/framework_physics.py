@@ -121,3 +121,54 @@ def fourbar_branch(crank_deg, coupler_deg) -> int:
     C = B + 2.2 * np.array([np.cos(f), np.sin(f)])
     gap = np.array([2.0, 0.0]) - B
     return 1 if gap[0] * (C - B)[1] - gap[1] * (C - B)[0] > 0 else -1
+
+
+PRISM_BASE = np.array(
+    [[1.0, 0.0, 0.0], [-0.5, 0.8660254037844386, 0.0], [-0.5, -0.8660254037844386, 0.0]]
+)
+
+
+def prism_nodes(angles, h=1.2):
+    """Top nodes A, B, C of examples/prism.toml: each on the sphere of radius h about its base
+    corner, from (polar, azimuth) angles (6 numbers): the bars hold exactly."""
+    a = np.asarray(angles, float).reshape(3, 2)
+    dirs = np.stack(
+        [np.sin(a[:, 0]) * np.cos(a[:, 1]), np.sin(a[:, 0]) * np.sin(a[:, 1]), np.cos(a[:, 0])],
+        axis=1,
+    )
+    return PRISM_BASE + h * dirs
+
+
+def prism_energy(angles, kt=1.0, kd=1.5):
+    """V of the prism (zero-free-length cables): top triangle, and A-b, B-c, C-a diagonals."""
+    n = prism_nodes(angles)
+    top = sum(np.sum((n[i] - n[(i + 1) % 3]) ** 2) for i in range(3))
+    diag = sum(np.sum((n[i] - PRISM_BASE[(i + 1) % 3]) ** 2) for i in range(3))
+    return kt / 2 * top + kd / 2 * diag
+
+
+def prism_minima(starts: int = 60, seed: int = 5) -> list[np.ndarray]:
+    """Node positions (3 x 3) of the minima that local descents from random poses reach
+    (gradient descent with a backtracking line search, then Newton, central differences)."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for _ in range(starts):
+        x = np.concatenate([[rng.uniform(0.05, np.pi - 0.05), rng.uniform(0, 2 * np.pi)]
+                            for _ in range(3)])  # fmt: skip
+        for _ in range(3000):
+            g = _gradient(prism_energy, x)
+            if np.linalg.norm(g) < 1e-10:
+                break
+            step = 1.0
+            while (
+                prism_energy(x - step * g) > prism_energy(x) - 0.5 * step * g @ g and step > 1e-12
+            ):
+                step /= 2
+            x = x - step * g
+        out.append(prism_nodes(x))
+    return out
+
+
+def _gradient(f, x, h=1e-6):
+    e = np.eye(len(x)) * h
+    return np.array([(f(x + e[k]) - f(x - e[k])) / (2 * h) for k in range(len(x))])

@@ -72,31 +72,65 @@ def completeness(fw: Framework, table: dict, report: dict) -> dict:
     morse = morse_count(fw, table)
     if morse["applicable"] and not morse["ok"]:
         warnings.append(
-            f"Morse count on the torus {morse['euler_characteristic']} != 0"
+            f"Morse count {morse['euler_characteristic']} != {morse['expected']}, the Euler "
+            f"characteristic of {morse['manifold']}"
             + (f" ({morse['degenerate']} degenerate)" if morse["degenerate"] else "")
             + ": equilibria may be missing"
         )
     return {"morse": morse, "warnings": warnings}
 
 
-def morse_count(fw: Framework, table: dict) -> dict:
-    """sum (-1)^index over the physical equilibria plus the cone maxima: 0 on a torus T^n."""
+def configuration_space(fw: Framework) -> tuple[list[str], str]:
+    """The factors of the configuration space when it is a closed manifold the Morse count
+    applies to (S1 per planar body and SO3 per spatial body of a pinned open chain, a sphere per
+    node hung from a placed point by one bar), else ([], why not)."""
     lay = layout(fw)
-    if fw.dim != 2 or not lay.is_torus:
-        return {"applicable": False, "ok": None, "reason": "the configuration space is not a "
-                "circle or torus (translations, nodes or closed loops)"}  # fmt: skip
+    if lay.translations or lay.closing_pins:
+        return [], "a body is not pinned to the ground or a pin closes a loop"
+    factors = ["S1" if fw.dim == 2 else "SO3" for _ in lay.rotations]
+    hung = []
+    for bar in fw.bars:
+        ends = [p for p in (bar.a, bar.b) if p in lay.free_nodes]
+        if len(ends) != 1 or bar.a in lay.free_nodes and bar.b in lay.free_nodes:
+            return [], f"bar {bar.name} closes a loop"
+        hung.append(ends[0])
+    if sorted(hung) != sorted(lay.free_nodes):
+        return [], "a node is not hung from a placed point by exactly one bar"
+    factors += ["S1" if fw.dim == 2 else "S2" for _ in hung]
+    return factors, ""
+
+
+def _collapsible(fw: Framework) -> list[str]:
+    """Springs with a free length whose ends may meet (V has a cone point there)."""
+    from ..model.framework.reach import length_bounds
+
+    slots = fw.slots()
+    return [x.name for x in fw.springs
+            if slots[f"L0_{x.name}"] > 0 and length_bounds(fw, x.a, x.b)[0] <= 0]  # fmt: skip
+
+
+def morse_count(fw: Framework, table: dict) -> dict:
+    """sum (-1)^index over the physical equilibria (plus the cone maxima) must equal the Euler
+    characteristic of the configuration space: 0 for a torus, 2^n for n spheres S2."""
+    factors, why = configuration_space(fw)
+    if not factors:
+        return {"applicable": False, "ok": None, "reason": why or "nothing moves"}
+    torus2 = factors == ["S1", "S1"] and fw.dim == 2
+    collapsible = _collapsible(fw)
+    if collapsible and not torus2:
+        return {"applicable": False, "ok": None, "reason": f"spring {collapsible[0]} may reach "
+                "zero length (a cone point of V the count cannot place)"}  # fmt: skip
+    chi = int(np.prod([{"S1": 0, "SO3": 0, "S2": 2}[f] for f in factors]))
     phys = np.asarray(table["physical"], dtype=bool)
     kinds = np.asarray(table["kind"], dtype=object)[phys]
     index = np.asarray(table["index"], dtype=int)[phys]
-    n = len(lay.rotations)
     counts = {k: int((kinds == k).sum()) for k in ("min", "saddle", "max", "degenerate")}
-    cones = cone_points(fw)
-    maxima = sum(c["is_max"] for c in cones)
+    maxima = sum(c["is_max"] for c in cone_points(fw)) if torus2 else 0
     total = int(sum((-1) ** int(i) for i, k in zip(index, kinds, strict=True) if k != "degenerate"))
-    total += maxima * (-1) ** n
-    ok = total == 0 and counts["degenerate"] == 0
-    return {"applicable": True, "torus_dimension": n, **counts, "zero_length_maxima": maxima,
-            "euler_characteristic": total, "ok": ok}  # fmt: skip
+    total += maxima * (-1) ** len(factors)
+    ok = total == chi and counts["degenerate"] == 0
+    return {"applicable": True, "manifold": " x ".join(factors), "expected": chi, **counts,
+            "zero_length_maxima": maxima, "euler_characteristic": total, "ok": ok}  # fmt: skip
 
 
 def cone_points(fw: Framework) -> list[dict]:

@@ -10,7 +10,7 @@ caller solves the point from the generic set instead.
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,12 +42,14 @@ class WarmStart:
     the point it was continued from and its solutions in the same order (for a secant
     prediction along a straight line of points), if it was."""
 
-    params: Params
+    params: Params | Mapping[str, float]  # a framework's: its normalised slots by name
     points: np.ndarray
     generic_key: str
-    before: tuple[Params, np.ndarray] | None = None
+    before: tuple[Params | Mapping[str, float], np.ndarray] | None = None
 
-    def next_to(self, params: Params, points: np.ndarray, key: str) -> WarmStart:
+    def next_to(
+        self, params: Params | Mapping[str, float], points: np.ndarray, key: str
+    ) -> WarmStart:
         """`params` solved by continuing this start (its `points` in this start's order)."""
         before = (self.params, self.points) if len(points) == len(self.points) else None
         return WarmStart(params, points, key, before)
@@ -161,7 +163,7 @@ _DETOUR = 0.5 + 0.5j  # the arc's largest excursion, relative to the step betwee
 
 
 def newton_continue(
-    ps: ParametricSystem, gs: GenericSet, warm: WarmStart, params: Params
+    ps: ParametricSystem, gs: GenericSet, warm: WarmStart, params: Params | Mapping[str, float]
 ) -> tuple[tuple | None, str]:
     """The solutions at `params` by Newton's method from the neighbour's, when provably complete.
 
@@ -178,7 +180,11 @@ def newton_continue(
     """
     if warm.generic_key != gs.key or len(warm.points) != len(gs.points):
         return None, "the previous point has another structure or an incomplete set"
-    system = polynomial_system(params.normalized())
+    system = (
+        polynomial_system(params.normalized())
+        if isinstance(params, Params)
+        else ps.instantiate(_normalised(ps, params))
+    )
     first = ""
     for stages, start in _attempts(ps, warm, params):
         x, size = np.array(start, dtype=complex), None
@@ -214,17 +220,25 @@ def _attempts(ps: ParametricSystem, warm: WarmStart, params: Params) -> Iterator
     normalised, Newton is run at in turn, None for the target itself; the starts)."""
     secant = _secant(warm, params)
     yield [None], (warm.points if secant is None else secant)
-    a, b = (
-        np.array([getattr(q.normalized(), n) for n in ps.parameters]) for q in (warm.params, params)
-    )
+    a, b = (_normalised(ps, q) for q in (warm.params, params))
     t = np.arange(1, _DETOUR_STEPS) / _DETOUR_STEPS
     yield [a + (b - a) * (s + 4 * _DETOUR * s * (1 - s)) for s in t] + [None], warm.points
     for k in _SUBSTEPS:
         yield [a + (b - a) * j / k for j in range(1, k)] + [None], warm.points
 
 
-def _vector(params: Params) -> np.ndarray:
-    return np.array(list(params.as_dict().values()), dtype=float)
+def _normalised(ps: ParametricSystem, params: Params | Mapping[str, float]) -> np.ndarray:
+    """The values of `ps`'s parameters in normalised units: a Params (the paper's model), or a
+    mapping of normalised values by name (a framework's slots)."""
+    if isinstance(params, Params):
+        params = params.normalized().as_dict()
+    return np.array([params[n] for n in ps.parameters], dtype=float)
+
+
+def _vector(params: Params | Mapping[str, float]) -> np.ndarray:
+    """Every value of a parameter set, for the secant's line test."""
+    values = params.as_dict() if isinstance(params, Params) else params
+    return np.array(list(values.values()), dtype=float)
 
 
 def _secant(warm: WarmStart, params: Params) -> np.ndarray | None:
@@ -233,9 +247,7 @@ def _secant(warm: WarmStart, params: Params) -> np.ndarray | None:
     if warm.before is None:
         return None
     before, points = warm.before
-    p0, p1, p2 = (
-        np.array(list(q.as_dict().values()), float) for q in (before, warm.params, params)
-    )
+    p0, p1, p2 = (_vector(q) for q in (before, warm.params, params))
     back, ahead = p1 - p0, p2 - p1
     t = float(ahead @ back) / float(back @ back) if back.any() else 0.0
     if t <= 0 or not np.allclose(ahead, t * back, rtol=0, atol=1e-12 * (1 + np.abs(p2).max())):

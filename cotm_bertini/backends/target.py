@@ -123,18 +123,26 @@ def solve_parameters(
     centre: dict[str, float],
     settings: Settings = Settings(),
     groups: list[list[str]] | None = None,
+    warm: WarmStart | None = None,
 ) -> HomotopySolve:
     """Every finite endpoint of `ps` at `target` (normalised parameter values), from the generic
     set around `centre`, with the fallbacks of solve_target; a second, independent generic set
     is solved too and its count recorded (`info["generic_counts"]`): two ab-initio solves with
     different random starts that agree are the completeness evidence of a framework solve.
-    `groups`: variable groups of a multihomogeneous start for the ab-initio solves."""
+    `groups`: variable groups of a multihomogeneous start for the ab-initio solves. `warm`: a
+    neighbouring point's complete set (a sweep): Newton from it first, accepted only when it
+    proves the set complete (`newton_continue`), else the generic set as without it."""
     deadline = None if settings.timeout is None else time.perf_counter() + settings.timeout
     centre = {n: centre[n] for n in ps.parameters}
     gs = generic_set(ps, settings.seed, centre=centre, groups=groups)
     gs2 = generic_set(ps, settings.seed + SECOND_START, centre=centre, groups=groups)
-    if ps.parameters:
+    result, note = (None, "") if warm is None else newton_continue(ps, gs, warm, target)
+    if result is not None:
+        endpoints, info, text = result
+    elif ps.parameters:
         endpoints, info, text = from_generic(ps, gs, target, settings, deadline, centre, groups)
+        if note:
+            info["method"] += f" ({note})"
     else:  # nothing to move: the generic set is the answer
         records = [{"path_number": k, "coords": p} for k, p in enumerate(gs.points)]
         endpoints = Endpoints.from_records(ps.variables, records)
@@ -156,4 +164,14 @@ def solve_parameters(
         generic_singular=gs.singular_endpoints,
         generic_counts=[len(gs.points), len(gs2.points)],
     )
-    return HomotopySolve(endpoints, info, gs, text)
+    return HomotopySolve(endpoints, info, gs, text, _next_start(gs, warm, target, endpoints, info))
+
+
+def _next_start(gs: GenericSet, warm, target, endpoints: Endpoints, info: dict):
+    """This target as a start for the next point of a sweep, when its set is complete (in the
+    warm start's order when continued from it: a secant start next)."""
+    if info["lost"] or info["finite"] != len(gs.points) or len(endpoints) != len(gs.points):
+        return None
+    if warm is not None and info["method"].startswith("Newton"):
+        return warm.next_to(dict(target), endpoints.points, gs.key)
+    return WarmStart(dict(target), endpoints.points, gs.key)

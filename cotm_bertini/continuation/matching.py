@@ -132,14 +132,18 @@ def assign_branches(sweep, param: str):
     return out
 
 
-def branch_ids(sweep, param: str) -> np.ndarray:
+def branch_ids(sweep, param: str, coords: np.ndarray | None = None) -> np.ndarray:
     """The branch of every row of `sweep` (a DataFrame or a mapping of columns), -1 for rows
     without finite angles: rows of each point (by solution_id) matched to the branches present
-    at the point before (in parameter order)."""
+    at the point before (in parameter order). `coords`: each row's matching coordinates
+    (default: the paper's model's, `match_coordinates`; rows with any NaN get -1)."""
     keys, _ = point_keys(sweep, param)
     branch = np.full(len(keys), -1, dtype=int)
-    coords = match_coordinates(sweep, _length_scale(sweep))
-    good = np.isfinite(coords[:, : len(ANGLE_VARS)]).all(axis=1)
+    if coords is None:
+        coords = match_coordinates(sweep, _length_scale(sweep))
+        good = np.isfinite(coords[:, : len(ANGLE_VARS)]).all(axis=1)
+    else:
+        good = np.isfinite(coords).all(axis=1)
     rank = {k: r for r, (k, _) in enumerate(point_order(sweep, param))}
     values = [v for _, v in point_order(sweep, param)]
     sid = _column(sweep, "solution_id") if "solution_id" in sweep else np.zeros(len(keys))

@@ -54,13 +54,23 @@ def finish_columns(
     store = PointStore(folder) if store is None else store
     table = assemble_columns(spec, folder, store)
     events: list[dict] = []
-    if spec.param2 is None:
+    names = event_columns(spec.param)
+    tables = ("sweep", "events", "solutions")
+    if spec.framework is not None:
+        from .framework import match_coordinates
+        from .framework_events import framework_event_columns, framework_event_records
+
+        names = framework_event_columns(spec.model, spec.param)
+        tables = ("framework_sweep", "framework_events", "framework")
+        if spec.param2 is None:
+            table["branch"] = branch_ids(table, spec.param, match_coordinates(spec.model, table))
+            events = framework_event_records(spec, table)
+    elif spec.param2 is None:
         table["branch"] = branch_ids(table, spec.param)
         events = event_records(table, spec.param, Params(**spec.base), spec.settings)
     atomic_write_text(folder / "sweep.csv", _sweep_text(spec, store, table.get("branch")))
-    names = event_columns(spec.param)
     atomic_write_text(folder / "events.csv", csv_text({n: [e[n] for e in events] for n in names}))
-    atomic_write_text(folder / "columns.md", reference("sweep", "events", "solutions"))
+    atomic_write_text(folder / "columns.md", reference(*tables))
     record = _record(spec, table, len(events), stats, workers, scheduler, command)
     record["timings"] = {"solve": stats["seconds"], "finish": time.perf_counter() - t0}
     write_json(folder / "run.json", record)

@@ -37,6 +37,10 @@ def point_columns(
     n = len(cols["solution_id"])
     homotopy = solved.details.get("homotopy")
     method = homotopy["method"] if homotopy else f"cli ({solved.engine['flavour']})"
+    if "taut_sets" in solved.details:  # a framework
+        from .framework import point_method
+
+        method = point_method(solved.details)
     lost = solved.counts["lost_paths"]
     out = {"point": np.full(n, index)}
     out.update({name: np.full(n, float(v)) for name, v in values.items()})
@@ -70,8 +74,9 @@ def solve_run(
     keep = 2 * (len(spec.values2) if spec.param2 else 1) + 2
     for index in indices:
         params = spec.params_at(index)
-        solved = solve_point(params, settings, warm=_start(spec, index, params.zfl, recent))
-        recent[index] = (solved.warm, params.zfl)
+        structure = getattr(params, "zfl", None)  # a framework's starts are keyed by system
+        solved = _solve(spec, params, settings, _start(spec, index, structure, recent))
+        recent[index] = (solved.warm, structure)
         if len(recent) > keep:
             del recent[next(iter(recent))]
         cols = point_columns(solved, spec.values_at(index), index)
@@ -81,12 +86,25 @@ def solve_run(
         yield index, cols, int(np.nan_to_num(cols["lost_paths"][:1]).sum()), text
 
 
+def _solve(spec: SweepSpec, params, settings: Settings, warm) -> PointSolution:
+    """One point: the paper's model, or a framework (each taut set continued from `warm`)."""
+    if spec.framework is not None:
+        from ..point import solve_framework_point
+
+        return solve_framework_point(params, settings, warm=warm)
+    return solve_point(params, settings, warm=warm)
+
+
 def sweep_names(spec: SweepSpec) -> list[str]:
     """The columns of sweep.csv (before `branch`), from the structures the grid holds: each
     point's columns in point_columns' order, joined in grid order (as pandas.concat joins)."""
     from ..analysis.classify import empty_columns
     from ..model.compiled import parametric_system
 
+    if spec.framework is not None:
+        from .framework import sweep_names as framework_names
+
+        return framework_names(spec.model, spec.columns)
     structures: dict[tuple[bool, bool], None] = {}  # Params.zfl of each point, in grid order
     for index in range(spec.size() if {"L01", "L02"} & set(spec.columns) else 1):
         values = {**spec.base, **spec.values_at(index)}
@@ -174,6 +192,11 @@ def load_spec(folder: Path) -> SweepSpec:
 def warm_generic_sets(spec: SweepSpec) -> None:
     """Solve (or load) the generic sets every point needs, once, before workers start."""
     if Settings(**spec.settings).engine != "homotopy":
+        return
+    if spec.framework is not None:
+        from .framework import warm_generic_sets as framework_sets
+
+        framework_sets(spec.params_at, sorted({0, spec.size() - 1}), spec.settings["seed"])
         return
     from ..backends.homotopy import generic_set
     from ..model.compiled import parametric_system

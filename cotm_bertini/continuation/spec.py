@@ -47,10 +47,13 @@ class SweepSpec:
     values2: tuple[float, ...] | None = None
     settings: dict = field(default_factory=lambda: Settings().as_dict())
     certify: bool = False  # prove every point (docs/certify.md)
+    framework: dict | None = None  # a framework's sweep: the framework (continuation.framework)
 
     def __post_init__(self) -> None:
+        if self.framework is not None:
+            self._check_framework()
         for name, option in ((self.param, "param"), (self.param2, "param2")):
-            if name is not None and name not in PARAM_NAMES:
+            if self.framework is None and name is not None and name not in PARAM_NAMES:
                 raise ParameterError(
                     f"{option} = {name!r}: unknown parameter (known: {' '.join(PARAM_NAMES)})"
                 )
@@ -65,7 +68,30 @@ class SweepSpec:
             raise ParameterError("values2 given without param2")
         Settings(**self.settings)  # validated here, before any work
         for values in (self.values_at(0), self.values_at(self.size() - 1)):
-            make_params(None, {**self.base, **values})  # a bad range fails here
+            if self.framework is None:
+                make_params(None, {**self.base, **values})  # a bad range fails here
+            else:
+                self.model.replace(**values)
+
+    def _check_framework(self) -> None:
+        from .framework import check_param, decode
+
+        fw = decode(self.framework)
+        object.__setattr__(self, "_model", fw.replace(**self.base))
+        check_param(fw, self.param, "param")
+        check_param(fw, self.param2, "param2")
+        if self.certify:
+            raise ParameterError("certify: proofs cover the paper's mechanism only, not a framework")
+        engine = self.settings.get("engine", "homotopy")
+        if engine != "homotopy":
+            raise ParameterError(
+                f"engine = {engine!r}: a framework is solved by the in-process homotopy engine"
+            )
+
+    @property
+    def model(self):
+        """The framework at the base values (a framework's sweep only)."""
+        return self._model
 
     @classmethod
     def linspace(cls, base: Params, param: str, start: float, stop: float, points: int, **kw):
@@ -137,8 +163,10 @@ class SweepSpec:
         size = max(1, -(-len(todo) // max(parts, 1)))
         return [run[k : k + size] for run in runs for k in range(0, len(run), size)]
 
-    def params_at(self, index: int) -> Params:
-        """The full parameter set of grid point `index`."""
+    def params_at(self, index: int):
+        """The full parameter set of grid point `index` (a framework's sweep: the framework)."""
+        if self.framework is not None:
+            return self.model.replace(**self.values_at(index))
         return Params(**{**self.base, **self.values_at(index)})
 
     def to_json(self) -> dict:
@@ -165,7 +193,8 @@ class SweepSpec:
         rng = f"{self.param}-{self.values[0]:g}-{self.values[-1]:g}-{len(self.values)}"
         if self.param2:
             rng += f"-{self.param2}-{self.values2[0]:g}-{self.values2[-1]:g}-{len(self.values2)}"
-        return f"sweep-{rng}-{self.key()}"
+        name = "" if self.framework is None else f"{self.model.name}-"
+        return f"sweep-{name}{rng}-{self.key()}"
 
 
 def linspace(name: str, start: float, stop: float, points: int) -> tuple[float, ...]:

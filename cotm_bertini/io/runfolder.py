@@ -120,7 +120,9 @@ def _real_rows_text(table: dict, rows: list[int]) -> str:
 def write_solution_files(folder: Path, point: PointSolution) -> None:
     """solutions.csv, columns.md and the input file (unless the solver wrote it)."""
     atomic_write_text(folder / SOLUTIONS_CSV, columns_csv(point.columns))
-    atomic_write_text(folder / COLUMNS_MD, reference("solutions", "counts"))
+    paper = "gamma1_deg" in point.columns
+    tables = ("solutions", "counts") if paper else ("framework", "framework_counts")
+    atomic_write_text(folder / COLUMNS_MD, reference(*tables))
     if not (folder / "input").exists():
         atomic_write_text(folder / "input", point.input_text)
 

@@ -73,7 +73,8 @@ def framework_system(fw: Framework, taut: tuple[str, ...]) -> FrameworkSystem:
 
 def variable_groups(fs: FrameworkSystem) -> list[list[str]]:
     """Variable groups of a multihomogeneous start: each body's rotation, all translations and
-    node coordinates together, and each length, force density and multiplier on its own (on
+    node coordinates together, each pin's force, and each length, force density and bar
+    multiplier on its own (on
     the paper's mechanism 224 paths instead of a total degree of 576)."""
     groups: dict[str, list[str]] = {}
     for v in fs.ps.variables:
@@ -82,6 +83,8 @@ def variable_groups(fs: FrameworkSystem) -> list[list[str]]:
             key = "rot " + rest
         elif head in ("t", "n"):
             key = "positions"
+        elif head == "mu" and rest.startswith("pin"):
+            key = "force " + rest.rsplit("_", 1)[0]  # a pin's force components together
         else:
             key = v
         groups.setdefault(key, []).append(v)

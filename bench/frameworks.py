@@ -1,0 +1,73 @@
+"""Frameworks (issue 18): each example's first solve (generic sets from scratch, in a fresh
+cache) and a later one, paths, and the paper's mechanism from cotm.toml against the built-in
+model. Usage: python bench/frameworks.py [--skip NAME ...] (the prism takes minutes)."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import pandas as pd
+from benchlib import BENCH, show, write_csv
+
+ROOT = BENCH.parent
+CLI = str(Path(sys.executable).with_name("cotm-bertini"))
+EXAMPLES = {
+    "zeeman": ["--set", "x=0.1", "--set", "y=-0.25"],
+    "zeeman_cables": ["--set", "x=1.45", "--set", "y=0.2"],
+    "cotm": [],
+    "double_pendulum": [],
+    "fourbar": [],
+    "prism": [],
+}
+
+
+def _run(args: list[str], env: dict) -> float:
+    """Seconds of one CLI run (no cache of results, no figures)."""
+    t0 = time.perf_counter()
+    subprocess.run([CLI, *args, "--no-cache", "--no-plots", "--quiet"], check=True, env=env,
+                   cwd=tempfile.mkdtemp(), capture_output=True)  # fmt: skip
+    return time.perf_counter() - t0
+
+
+def _row(name: str, env: dict) -> dict:
+    import cotm_bertini as cb
+
+    args = ["solve", "--framework", str(ROOT / "examples" / f"{name}.toml"), *EXAMPLES[name]]
+    first = _run(args, env)
+    later = min(_run(args, env) for _ in range(3))
+    os.environ["COTM_CACHE"] = env["COTM_CACHE"]
+    fw = cb.Framework.from_toml(ROOT / "examples" / f"{name}.toml")
+    sets = dict(a.split("=") for a in EXAMPLES[name][1::2])
+    res = cb.solve(fw.replace(**{k: float(v) for k, v in sets.items()}))
+    c = res.counts
+    return {"example": name, "first_solve_s": first, "later_solve_s": later,
+            "generic_paths": c["generic_paths"], "paths_tracked": c["paths_tracked"],
+            "physical": c["physical"], "stable": c["stable"], "status": res.status,
+            "morse": res.morse.get("manifold", "n/a")}  # fmt: skip
+
+
+def main() -> None:
+    """Print and write bench/results/frameworks.csv."""
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--skip", nargs="*", default=[])
+    opts = ap.parse_args()
+    env = {**os.environ, "COTM_CACHE": tempfile.mkdtemp(prefix="cotm-bench-fw-")}
+    rows = [_row(n, env) for n in EXAMPLES if n not in opts.skip]
+    builtin = min(_run(["solve", "case3"], env) for _ in range(3))
+    frame = pd.DataFrame(rows)
+    show("frameworks: CLI solve, end to end (s)", frame, {"first_solve_s": ".1f"})
+    print(f"\nbuilt-in `solve case3` (same run, cached generic set): {builtin:.2f} s; "
+          f"cotm.toml later solve / built-in: "
+          f"{frame.set_index('example').loc['cotm', 'later_solve_s'] / builtin:.1f}x"
+          if "cotm" in frame["example"].values else "")  # fmt: skip
+    write_csv(frame, "frameworks")
+
+
+if __name__ == "__main__":
+    main()

@@ -210,6 +210,37 @@ FRAMEWORK_COUNTS = {
 }
 
 
+FRAMEWORK_SWEEP = {
+    "point": "index of the sweep point (grid order; the second parameter varies fastest)",
+    "<param>, <param2>": "the swept framework parameters' values at this point",
+    "framework solutions.csv columns": "as in a framework's solutions.csv, one row per finite "
+    "solution of the point (every taut set)",
+    "method": "how each taut set was solved: Newton from the neighbouring point (complete: as "
+    "many distinct nonsingular roots as the generic set), or parameter homotopy from the generic "
+    "set (with why Newton was refused)",
+    "lost_paths": "paths that failed at this point, over every taut set",
+    "status": "ok, or incomplete when a completeness check of the point failed",
+    "branch": "1-D sweeps: which branch the row belongs to (secant prediction + one-to-one "
+    "assignment on the poses and link lengths; complex rows by their real parts)",
+}
+
+FRAMEWORK_EVENTS = {
+    "kind": "fold (the number of physical equilibria changes by two: a pair is born or meets "
+    "and vanishes), physical_change (it changes by one: a length or a cable reaches its limit) "
+    "or stability_change (the number of stable ones changes; at a fold too)",
+    "branches": "the branch ids at the neighbouring sweep point of the rows involved (a+b)",
+    "<param>": "the event's parameter value: the middle of the final bisection bracket",
+    "pose columns": "BODY.angle_deg (planar), BODY.qw ... (spatial), NODE.x ...: the mean pose "
+    "of the merging equilibria at the bracket's end where they are real",
+    "hess_min_eig": "the largest |smallest reduced-Hessian eigenvalue| of those equilibria there "
+    "(tends to 0 at a fold)",
+    "refined": "every probe of the bisection was a complete solve (status ok)",
+    "bracket": "the final bisection bracket's width (the value's accuracy)",
+    "description": "what happens, in words",
+    "lo, hi": "the sweep points on either side",
+}
+
+
 def markdown(title: str, columns: dict[str, str], head: str = "column") -> str:
     """A Markdown table of columns (or other names) and their meanings."""
     lines = [f"## {title}", "", f"| {head} | meaning |", "|---|---|"]
@@ -219,7 +250,8 @@ def markdown(title: str, columns: dict[str, str], head: str = "column") -> str:
 
 def reference(*tables: str, title: str = "Columns of the CSV files in this folder") -> str:
     """The column reference of a run folder: 'solutions', 'counts', 'sweep', 'events',
-    'barriers', 'folds', 'regions', 'design', 'framework', 'framework_counts'."""
+    'barriers', 'folds', 'regions', 'design', 'framework', 'framework_counts',
+    'framework_sweep', 'framework_events'."""
     known = {
         "solutions": ("solutions.csv", SOLUTIONS),
         "counts": ("counts (run.json `counts`, `res.counts`)", COUNTS, "count"),
@@ -231,6 +263,8 @@ def reference(*tables: str, title: str = "Columns of the CSV files in this folde
         "design": ("the design CSV (`cotm-bertini design --out`)", DESIGN),
         "framework": ("solutions.csv of a framework (`--framework`)", FRAMEWORK),
         "framework_counts": ("counts of a framework solve", FRAMEWORK_COUNTS, "count"),
+        "framework_sweep": ("sweep.csv of a framework", FRAMEWORK_SWEEP),
+        "framework_events": ("events.csv of a framework", FRAMEWORK_EVENTS),
     }
     parts = [f"# {title}\n"]
     parts += [markdown(*known[t]) for t in tables]
@@ -250,5 +284,7 @@ def document() -> str:
         "design",
         "framework",
         "framework_counts",
+        "framework_sweep",
+        "framework_events",
         title="Columns of the CSV files",
     )

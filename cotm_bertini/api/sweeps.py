@@ -75,7 +75,13 @@ class Sweep:
         path = (
             Path(path) if path is not None else self.folder / ("bifurcation" if one_d else "counts")
         )
-        if one_d:
+        if one_d and self.spec.framework is not None:
+            from ..plot.framework_sweep import plot_framework_sweep
+
+            written = plot_framework_sweep(
+                self.spec.model, self.table, self.spec.param, path, self.events
+            )
+        elif one_d:
             from ..plot.bifurcation import plot_bifurcation
 
             fixed = {k: v for k, v in self.spec.base.items() if k != self.spec.param}
@@ -95,7 +101,7 @@ class Sweep:
 
 
 def sweep(
-    params: Params,
+    params,
     param: str,
     values: Sequence[float],
     settings: Settings | None = None,
@@ -110,8 +116,9 @@ def sweep(
     certify: bool = False,
     **options,
 ) -> Sweep:
-    """Solve `params` at every value of `param` (and of `param2`: a grid), then find branches
-    and events. Options are Settings fields, as for `solve`.
+    """Solve `params` (cb.Params, or a cb.Framework: then `param` names one of its parameters)
+    at every value of `param` (and of `param2`: a grid), then find branches and events. Options
+    are Settings fields, as for `solve`.
 
     The points are solved on `workers` local processes (or a Dask cluster at `scheduler`) and
     stored one by one under `out` (default: the cache folder), so the same request resumes where
@@ -123,9 +130,14 @@ def sweep(
 
     check_workers(workers)  # before any folder is made
     settings = (settings or Settings()).replace(**options)
+    framework = None
+    if not isinstance(params, Params):  # a cb.Framework: its parameters are swept
+        from ..continuation.framework import encode
+
+        framework = encode(params)
     spec = SweepSpec(
         params.as_dict(), param, tuple(values), param2,
-        None if values2 is None else tuple(values2), settings.as_dict(), certify,
+        None if values2 is None else tuple(values2), settings.as_dict(), certify, framework,
     )  # fmt: skip
     root = cache_root() / "sweeps" if out is None else output_root(out, "out")
     folder = prepare(spec, root / spec.folder_name())

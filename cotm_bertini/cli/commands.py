@@ -107,7 +107,10 @@ def _check_points(name: str, start: float, stop: float, points: int | None, suff
         )
 
 
-def _sweep_spec_values(args: argparse.Namespace, which: str) -> tuple[float, ...] | None:
+def _sweep_spec_values(
+    args: argparse.Namespace, which: str, known: tuple[str, ...] | None = None
+) -> tuple[float, ...] | None:
+    """The values of --param (or --param2); `known`: a framework's parameter names."""
     from ..continuation.spec import DEFAULT_RANGES, linspace
     from ..params import PARAM_NAMES
 
@@ -121,10 +124,9 @@ def _sweep_spec_values(args: argparse.Namespace, which: str) -> tuple[float, ...
                     "given without --param2"
                 )
         return None
-    if name not in PARAM_NAMES:
-        raise ParameterError(
-            f"--{which} {name!r}: unknown parameter (known: {' '.join(PARAM_NAMES)})"
-        )
+    if name not in (PARAM_NAMES if known is None else known):
+        names = " ".join(PARAM_NAMES if known is None else known) or "none"
+        raise ParameterError(f"--{which} {name!r}: unknown parameter (known: {names})")
     if suffix and name == args.param:
         raise ParameterError(f"--param2 {name!r}: same as --param")
     start, stop = getattr(args, "start" + suffix), getattr(args, "stop" + suffix)
@@ -147,6 +149,7 @@ def sweep(args: argparse.Namespace) -> int:
     from ..api.sweeps import resume_sweep
     from ..api.sweeps import sweep as sweep_params
     from ..continuation.runner import SPEC_FILE, default_workers
+    from ..params import Params
 
     workers = default_workers() if args.workers is None else args.workers
     if isinstance(workers, int) and workers < 1:
@@ -157,9 +160,10 @@ def sweep(args: argparse.Namespace) -> int:
     if args.resume:
         sw = resume_sweep(args.resume, workers, args.scheduler, progress, sys.argv[:])
     else:
-        values = _sweep_spec_values(args, "param")
-        values2 = _sweep_spec_values(args, "param2")
         base = params_from(args)
+        known = None if isinstance(base, Params) else tuple(base.values)
+        values = _sweep_spec_values(args, "param", known)
+        values2 = _sweep_spec_values(args, "param2", known)
         sw = sweep_params(
             base, args.param, values, settings_from(args), param2=args.param2,
             values2=values2, workers=workers, scheduler=args.scheduler,

@@ -81,7 +81,7 @@ class SweepSpec:
         check_param(fw, self.param, "param")
         check_param(fw, self.param2, "param2")
         if self.certify:
-            raise ParameterError("certify: proofs cover the paper's mechanism only, not a framework")
+            raise ParameterError("certify: proofs cover the paper's mechanism only, not frameworks")
         engine = self.settings.get("engine", "homotopy")
         if engine != "homotopy":
             raise ParameterError(

@@ -97,7 +97,8 @@ def gradient_norm(f, x) -> float:
 def fourbar_energy(theta, branch: int, ex=1.0, ey=2.0, L0=0.5):
     """V of examples/fourbar.toml at crank angle theta on one assembly branch (+1 or -1):
     the coupler's tip meets the rocker's where the circles |C - B| = 2.2, |C - D| = 1.5 cross."""
-    theta = np.asarray(theta, float)
+    scalar = np.ndim(theta) == 0
+    theta = np.atleast_1d(np.asarray(theta, float))
     B = np.stack([np.cos(theta), np.sin(theta)])
     D = np.array([2.0, 0.0])[:, None]
     gap = D - B
@@ -111,7 +112,8 @@ def fourbar_energy(theta, branch: int, ex=1.0, ey=2.0, L0=0.5):
     p = B + 1.1 * u + 0.5 * np.stack([-u[1], u[0]])
     lift = np.hypot(p[0] - ex, p[1] - ey)
     tie = np.hypot(B[0] + 1.0, B[1] + 1.0)
-    return 1.0 / 2 * np.maximum(lift - L0, 0) ** 2 + 2.0 / 2 * tie**2
+    V = 1.0 / 2 * np.maximum(lift - L0, 0) ** 2 + 2.0 / 2 * tie**2
+    return V[0] if scalar else V
 
 
 def fourbar_branch(crank_deg, coupler_deg) -> int:

@@ -88,8 +88,8 @@ def pose_names(fw: Framework) -> list[str]:
 def match_coordinates(fw: Framework, table) -> np.ndarray:
     """Coordinates of each row for joining branches: (cos, sin) of every planar body's angle,
     quaternions, node positions and link lengths in units of the framework's largest length
-    (real parts: a framework's table holds no imaginary parts, so a complex-conjugate pair
-    shares its coordinates)."""
+    (real parts: a framework's table holds no imaginary parts), and each row's distance from
+    the real plane, signed to tell a complex-conjugate pair apart."""
     from ..model.framework.units import units
 
     length = units(fw)[0]
@@ -102,8 +102,23 @@ def match_coordinates(fw: Framework, table) -> np.ndarray:
             cols.append(values / (1.0 if ".q" in name else length))
     for link in fw.links:
         cols.append(np.asarray(table[f"{link.name}.length"], dtype=float) / length)
-    n = len(np.asarray(table["point"]))
-    return np.stack(cols, axis=1).astype(complex) if cols else np.zeros((n, 0), complex)
+    cols.append(_pair_sides(table, cols))
+    return np.stack(cols, axis=1).astype(complex)
+
+
+def _pair_sides(table, cols: list[np.ndarray]) -> np.ndarray:
+    """+max_imag, and -max_imag for the second row of a complex-conjugate pair (the rows that
+    follow each other in a point with equal real parts): the pair's two members then continue
+    to their own branches, and the assignment rarely meets a tie."""
+    imag = np.asarray(table["max_imag"], dtype=float)
+    if len(imag) < 2:
+        return imag
+    coords = np.stack(cols, axis=1)
+    point = np.asarray(table["point"])
+    real = np.asarray(table["is_real"], dtype=bool)
+    twin = (point[1:] == point[:-1]) & ~real[1:] & ~real[:-1]
+    twin &= np.abs(coords[1:] - coords[:-1]).max(axis=1, initial=0.0) < 1e-9
+    return imag * np.concatenate([[1.0], np.where(twin, -1.0, 1.0)])
 
 
 def warm_generic_sets(fw_at, indices: list[int], seed: int) -> None:

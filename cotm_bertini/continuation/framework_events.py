@@ -60,8 +60,11 @@ class _Bracket:
 
 
 def _bisect(spec, pa: float, pb: float) -> _Bracket:
-    """Bisect [pa, pb] on the (physical, stable) counts, each probe continued from the lower
-    end's complete set; not refined if a probe's completeness check fails."""
+    """Shrink [pa, pb] around the change of the (physical, stable) counts, each probe a full
+    solve continued from the lower end's complete set; not refined if a probe's completeness
+    check fails. At a fold the product of the merging pair's smallest Hessian eigenvalues
+    vanishes linearly: its secant extrapolation picks the next probe (when two probes have not
+    halved the bracket, a bisection)."""
     from ..point import solve_framework_point
     from .runner import point_settings
 
@@ -75,17 +78,50 @@ def _bisect(spec, pa: float, pb: float) -> _Bracket:
     below = solve(lo)
     above = solve(hi, below.warm)
     ok = below.status == "ok" and above.status == "ok"
-    start = _signature(below.columns)
+    start, end = _signature(below.columns), _signature(above.columns)
+    fold = abs(start[0] - end[0]) == 2
+    real_low = start[0] > end[0]
+    seen = (
+        [(lo, _pair_product(below.columns))] if real_low else [(hi, _pair_product(above.columns))]
+    )
     tol = BISECT_TOL * max(1.0, abs(pa), abs(pb))
+    widths, last = [hi - lo, hi - lo], None
     while hi - lo > tol:
-        mid = 0.5 * (lo + hi)
-        probe = solve(mid, below.warm)
+        value, guess = 0.5 * (lo + hi), _secant(seen) if fold else None
+        if guess is not None and lo < guess < hi and hi - lo <= 0.5 * widths[-2]:
+            # Beside the guess by its last change (about its error), towards the farther end
+            # of the bracket, so that both ends close in.
+            move = max(tol / 4, abs(guess - last) if last is not None else (hi - lo) / 8)
+            near = guess - move if guess - lo > hi - guess else guess + move
+            value, last = (near if lo < near < hi else value), guess
+        probe = solve(value, below.warm)
         ok = ok and probe.status == "ok"
-        if _signature(probe.columns) == start:
-            lo, below = mid, probe
+        low_side = _signature(probe.columns) == start
+        if low_side:
+            lo, below = value, probe
         else:
-            hi, above = mid, probe
+            hi, above = value, probe
+        if low_side == real_low:
+            seen.append((value, _pair_product(probe.columns)))
+        widths.append(hi - lo)
     return _Bracket(lo, hi, below, above, ok, (pa, pb))
+
+
+def _pair_product(cols) -> float:
+    """|eig1 eig2| of the two physical rows whose smallest Hessian eigenvalue is nearest 0."""
+    rows = _closest_to_zero(cols, 2)
+    eig = np.abs(np.asarray(cols["hess_min_eig"], dtype=float)[rows])
+    return float(np.prod(eig)) if len(eig) == 2 else float("nan")
+
+
+def _secant(seen: list[tuple[float, float]]) -> float | None:
+    """Where the secant through the two real-side probes nearest the fold reaches 0, or None."""
+    if len(seen) < 2:
+        return None
+    (p1, g1), (p2, g2) = seen[-2], seen[-1]
+    if not np.isfinite([g1, g2]).all() or g1 == g2:
+        return None
+    return p2 + g2 * (p2 - p1) / (g1 - g2)
 
 
 def _describe(spec, b: _Bracket, grid_lo: dict, grid_hi: dict) -> list[dict]:

@@ -33,7 +33,7 @@ def _minima(y: float, n: int = 20_000) -> int:
 def _scan_folds() -> list[float]:
     """The y values where the number of minima of V changes: found on a fine y grid, each
     bracket bisected on the count to 1e-8."""
-    grid = np.linspace(-1.0, 0.5, 1501)
+    grid = np.linspace(-1.0, 0.5, 601)
     counts = [_minima(y) for y in grid]
     out = []
     for k in np.flatnonzero(np.diff(counts)):
@@ -146,12 +146,13 @@ def test_resume_after_an_interruption(tmp_path, zeeman_sweep):
     assert again.folder == folder and again.record["stats"]["skipped"] == 39
     a, b = again.table, zeeman_sweep.table
     assert len(a) == len(b) and not a.duplicated(["point", "solution_id"]).any()
-    # A complex-conjugate pair shares every column (real parts): its two branch ids may swap,
-    # so the real rows' branches are the same up to relabelling.
+    # How a point was reached (method, path numbers) may differ. A complex-conjugate pair
+    # shares every column (real parts): its two branch ids may swap, so the real rows'
+    # branches are the same up to relabelling.
+    route = ["method", "branch", "paths"]
     pd.testing.assert_frame_equal(
-        a.drop(columns=["method", "branch"]), b.drop(columns=["method", "branch"]),
-        check_exact=False, rtol=1e-7, atol=1e-9,
-    )  # fmt: skip
+        a.drop(columns=route), b.drop(columns=route), check_exact=False, rtol=1e-7, atol=1e-9
+    )
     real = a["is_real"].to_numpy()
     pairs = set(zip(a["branch"][real], b["branch"][real], strict=True))
     assert len(pairs) == len({p for p, _ in pairs}) == len({q for _, q in pairs})
@@ -165,3 +166,18 @@ def test_spec_round_trips_the_framework():
     again = SweepSpec.from_json(spec.to_json())
     assert again == spec and again.key() == spec.key()
     assert again.params_at(1) == fw.replace(y=0.1)
+
+
+def test_two_workers_give_the_same_rows_and_events(tmp_path):
+    """Worker processes decode the framework from the spec: the rows and events of one."""
+    fw = cb.Framework.from_toml(ZEEMAN).replace(x=X)
+    values = np.linspace(-0.5, 0.0, 21)
+    two = cb.sweep(fw, "y", values, out=tmp_path / "two", workers=2)
+    one = cb.sweep(fw, "y", values, out=tmp_path / "one")
+    route = ["method", "branch", "paths"]
+    pd.testing.assert_frame_equal(
+        two.table.drop(columns=route), one.table.drop(columns=route), check_exact=False,
+        rtol=1e-7, atol=1e-9,
+    )  # fmt: skip
+    assert np.allclose(two.events["y"], one.events["y"], rtol=0, atol=1e-8)
+    assert len(one.events) == 4

@@ -201,7 +201,7 @@ def solve_framework_point(
     taut set from that point by Newton (backends.target.solve_parameters)."""
     from .analysis.framework_checks import completeness, framework_counts, order_rows
     from .model.framework.compiled import framework_system
-    from .model.framework.derive import check_mobility
+    from .model.framework.structure import check_mobility
     from .model.framework.units import normalized_slots, units
 
     if settings.engine != "homotopy":

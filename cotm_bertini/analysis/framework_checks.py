@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..model.framework.compiled import FrameworkSystem, framework_system, slot_vector
-from ..model.framework.derive import layout
 from ..model.framework.spec import Framework
+from ..model.framework.structure import layout
 from ..model.framework.units import normalized_slots
 from ..settings import Settings
 from .framework_classify import column_names, positions

@@ -15,8 +15,8 @@ import numpy as np
 
 from ...fs import atomic_write_text, cache_root
 from ..polynomial import ParametricSystem
-from .derive import Derived, structure_key
 from .spec import Framework
+from .structure import Derived, structure_key
 from .units import scale_of
 
 

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import math
 
-from .derive import layout
 from .spec import Framework, owner
+from .structure import layout
 
 
 def _walk(fw: Framework, point: str, placed: dict, vals: dict) -> tuple | None:

@@ -7,6 +7,8 @@ numbers that depend on no parameter are written as constants) stay the same acro
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 from .spec import Framework
 
 # How each slot scales with the length unit L and the stiffness unit k.
@@ -23,6 +25,7 @@ def scale_of(kind: str, length: float, stiffness: float) -> float:
     return {"rot": 1.0, "len": length, "k": stiffness, "force": stiffness * length}[kind]
 
 
+@lru_cache(maxsize=256)
 def units(fw: Framework) -> tuple[float, float]:
     """(length unit, stiffness unit): the largest length and the largest k at the file's values."""
     slots = fw.at_defaults().slots()
@@ -32,9 +35,14 @@ def units(fw: Framework) -> tuple[float, float]:
 
 
 def normalized_slots(fw: Framework) -> dict[str, float]:
-    """Every slot in the framework's units."""
+    """Every slot in the framework's units (a fresh dict: callers may keep or change it)."""
+    return dict(_normalized(fw))
+
+
+@lru_cache(maxsize=256)
+def _normalized(fw: Framework) -> tuple[tuple[str, float], ...]:
     length, stiffness = units(fw)
-    return {n: v / scale_of(slot_kind(n), length, stiffness) for n, v in fw.slots().items()}
+    return tuple((n, v / scale_of(slot_kind(n), length, stiffness)) for n, v in fw.slots().items())
 
 
 def constants(fw: Framework) -> dict[str, float]:

@@ -324,7 +324,7 @@ def design_map(args: argparse.Namespace) -> int:
         f"{len(found.folds)} fold points on {pieces} pieces, {cusps} cusps; {spread}"
     )
     print(_files_line(folder))
-    print(f"the 2-D sweep behind regions.csv: {folder / SWEEP_FOLDER} (sweep.csv, points/)")
+    print(f"the 2-D sweep behind regions.csv: {folder / SWEEP_FOLDER} (sweep.csv, points.bin)")
     return EXIT_OK if found.record["sweep_status"] == "ok" else EXIT_INCOMPLETE
 
 

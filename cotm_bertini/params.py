@@ -202,6 +202,13 @@ def parse_assignment(text: str) -> tuple[str, float]:
 def load_toml(path: str | Path, option: str = "path") -> dict[str, float]:
     """Read a TOML file of top-level parameter values (any subset of PARAM_NAMES); errors name
     `option` (the Python argument, or the command line's `--params`)."""
+    data = read_toml(path, option)
+    return {name: coerce(name, value) for name, value in data.items()}
+
+
+def read_toml(path: str | Path, option: str) -> dict:
+    """A TOML file's tables; a missing file, a folder or bad TOML is one ParameterError naming
+    `option` and the path."""
     path = Path(path)
     try:
         with path.open("rb") as fh:
@@ -212,7 +219,7 @@ def load_toml(path: str | Path, option: str = "path") -> dict[str, float]:
         raise ParameterError(f"{option} {str(path)!r}: is a directory, not a file") from None
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError(f"{option} {str(path)!r}: not valid TOML ({exc})") from None
-    return {name: coerce(name, value) for name, value in data.items()}
+    return data
 
 
 def make_params(case: str | None = None, overrides: dict[str, object] | None = None) -> Params:

@@ -81,30 +81,10 @@ def derive(zfl: tuple[bool, bool]) -> SymbolicSystem:
 @cache
 def derive_parametric(zfl: tuple[bool, bool]) -> ParametricSystem:
     """`derive` as numbers: sparse terms in the variables and the parameters, and Bertini text."""
+    from .symbolic import parametric_from_sympy
+
     sym = derive(zfl)
-    xs = [sp.Symbol(n) for n in sym.variables]
-    used = sorted(
-        {s.name for f in sym.functions for s in f.free_symbols} & set(PARAM_NAMES),
-        key=PARAM_NAMES.index,
-    )
-    ps = [PSYM[n] for n in used]
-    var_exps, par_exps, coeffs, texts = [], [], [], []
-    for f in sym.functions:
-        poly = sp.Poly(f, *xs, *ps)
-        terms = poly.terms()
-        var_exps.append(np.array([m[: len(xs)] for m, _ in terms], dtype=np.int64))
-        par_exps.append(np.array([m[len(xs) :] for m, _ in terms], dtype=np.int64))
-        coeffs.append(np.array([float(c) for _, c in terms], dtype=float))
-        texts.append(sp.sstr(f).replace("**", "^"))
-    return ParametricSystem(
-        sym.variables,
-        sym.names,
-        tuple(used),
-        tuple(var_exps),
-        tuple(par_exps),
-        tuple(coeffs),
-        tuple(texts),
-    )
+    return parametric_from_sympy(sym.variables, sym.names, sym.functions, PARAM_NAMES)
 
 
 # --- energy in the angles -------------------------------------------------------------------

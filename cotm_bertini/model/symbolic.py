@@ -18,10 +18,11 @@ def parametric_from_sympy(
 
     Parameters that no function uses are dropped (the system's `parameters` lists the used ones
     in the given order)."""
-    xs = [sp.Symbol(n) for n in variables]
-    used_names = {s.name for f in functions for s in f.free_symbols}
-    used = tuple(n for n in parameters if n in used_names)
-    ps = [sp.Symbol(n) for n in used]
+    # The functions' own symbols by name (whatever assumptions they were made with).
+    named = {s.name: s for f in functions for s in f.free_symbols}
+    xs = [named.get(n, sp.Symbol(n)) for n in variables]
+    used = tuple(n for n in parameters if n in named)
+    ps = [named[n] for n in used]
     var_exps, par_exps, coeffs, texts = [], [], [], []
     for f in functions:
         poly = sp.Poly(sp.expand(f), *xs, *ps)

@@ -11,11 +11,11 @@ from __future__ import annotations
 import hashlib
 import math
 import re
-import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 from ...errors import ParameterError
+from ...params import read_toml
 from .expressions import Expr, parse
 
 _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
@@ -70,16 +70,7 @@ class Framework:
     @classmethod
     def from_toml(cls, path: str | Path) -> Framework:
         """Read and validate a framework file; errors name the element and the problem."""
-        path = Path(path)
-        try:
-            with path.open("rb") as fh:
-                data = tomllib.load(fh)
-        except FileNotFoundError:
-            raise ParameterError(f"framework file {str(path)!r}: file not found") from None
-        except IsADirectoryError:
-            raise ParameterError(f"framework file {str(path)!r}: is a directory") from None
-        except tomllib.TOMLDecodeError as exc:
-            raise ParameterError(f"framework file {str(path)!r}: not valid TOML ({exc})") from None
+        data = read_toml(path, "framework file")
         return from_dict(data, source=str(path))
 
     @property

@@ -87,9 +87,12 @@ def merge_endpoints(
     endpoints: Endpoints,
     tol: Tolerances,
     snapped: np.ndarray | None = None,
+    scaled: bool = False,
 ) -> Merged:
     """Newton-refine endpoints `x0` (normalised units) and cluster them into distinct solutions;
-    `snapped` marks points put exactly on a known singular root (not refined, singular)."""
+    `snapped` marks points put exactly on a known singular root (not refined, singular);
+    `scaled`: judge singularity on the equilibrated Jacobian (frameworks, whose force densities
+    range widely)."""
     snapped = np.zeros(len(x0), dtype=bool) if snapped is None else snapped
     acc = np.nan_to_num(endpoints.accuracy_estimate, nan=0.0)
     # The snapped points are exact (and exactly singular): Newton has nothing to do there.
@@ -98,7 +101,9 @@ def merge_endpoints(
         x[~snapped], res[~snapped] = newton_refine(system, x0[~snapped], tol.newton_steps)
     # Our own condition number at the refined point: Bertini's estimate is taken wherever its
     # endgame stopped and varies by orders of magnitude between runs near a singular root.
-    jac_cond = np.linalg.cond(system.jacobian(x)) if len(x) else np.zeros(0)
+    jac_cond = (
+        np.linalg.cond(_equilibrated(system.jacobian(x), x, scaled)) if len(x) else np.zeros(0)
+    )
     jac_cond = np.where(np.isfinite(jac_cond), jac_cond, np.inf)
     singular = (jac_cond > tol.singular_condition) | (endpoints.bertini_multiplicity > 1) | snapped
     labels = cluster_endpoints(x, singular, acc, tol.merge)
@@ -113,6 +118,16 @@ def merge_endpoints(
         singular=np.array([bool(singular[m].any() or len(m) > 1) for m in groups], dtype=bool),
         accuracy=np.array([acc[m].max() for m in groups]),
     )
+
+
+def _equilibrated(jac: np.ndarray, x: np.ndarray, scaled: bool) -> np.ndarray:
+    """With `scaled`, the Jacobian in relative variables (columns times max(1, |x_j|)) with unit
+    rows: a force density of 1e3 near a spring of almost zero length is not a singularity."""
+    if not scaled:
+        return jac
+    jac = jac * np.maximum(1.0, np.abs(x))[:, None, :]
+    norms = np.linalg.norm(jac, axis=2, keepdims=True)
+    return jac / np.where(norms > 0, norms, 1.0)
 
 
 def classify(params: Params, endpoints: Endpoints, tol: Tolerances = Tolerances()):

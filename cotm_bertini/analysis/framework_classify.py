@@ -25,7 +25,7 @@ def framework_columns(
     """One row per distinct solution of one taut set (endpoints in normalised units)."""
     slots_n = normalized_slots(fw)
     system = fs.ps.instantiate([slots_n[n] for n in fs.ps.parameters])
-    merged = merge_endpoints(system, endpoints.points, endpoints, tol)
+    merged = merge_endpoints(system, endpoints.points, endpoints, tol, scaled=True)
     x = merged.x
     max_imag = (np.abs(x.imag) / (1.0 + np.abs(x.real))).max(axis=1) if len(x) else np.zeros(0)
     loose = np.minimum(10.0 * np.sqrt(np.maximum(merged.accuracy, 1e-16)), 1e-4)
@@ -88,7 +88,7 @@ def _pose_columns(fw: Framework, fs: FrameworkSystem, var: dict, pos: dict) -> d
             cols[f"{body}.{_AXES[a]}"] = pos[body][:, a].real
         if fw.dim == 2:
             angle = np.degrees(np.arctan2(var[f"s_{body}"].real, var[f"c_{body}"].real))
-            cols[f"{body}.angle_deg"] = wrap_degrees(angle, 9)
+            cols[f"{body}.angle_deg"] = wrap_degrees(angle)
         else:
             q = np.stack([var[f"q{c}_{body}"].real for c in "wxyz"], axis=1)
             # q and -q are one pose: the first non-zero component is made positive.

@@ -13,7 +13,7 @@ import pandas as pd
 from ..columns import reference
 from ..fs import atomic_write_text, new_folder, write_csv
 from ..params import Params
-from .solutions import Solutions
+from .solutions import Solutions, paper_only
 
 BARRIERS_CSV = "barriers.csv"
 
@@ -72,6 +72,7 @@ def barriers(res: Solutions) -> Barriers:
     """For a solve: every physical saddle's descents to the minima, and the barriers."""
     from ..analysis.barriers import saddle_connections
 
+    paper_only(res, "barriers")
     t0 = time.perf_counter()
     table, paths = saddle_connections(res.params, res.table)
     table = table.set_axis(pd.Index(table["saddle_id"].to_numpy(dtype=int)), axis=0)

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ..errors import CertificateError
-from .solutions import Solutions
+from .solutions import Solutions, paper_only
 
 
 def certify(res: Solutions, strict: bool = True):
@@ -18,6 +18,7 @@ def certify(res: Solutions, strict: bool = True):
     """
     from ..analysis.certify import certify_table
 
+    paper_only(res, "certify")
     cert = certify_table(res.params, res.table.reset_index(drop=True))  # rows by position
     res.attach_certificate(cert)
     if strict and cert.status == "contradiction":

@@ -15,6 +15,16 @@ from pathlib import Path
 from .errors import ParameterError
 
 
+def files_hash(paths) -> str:
+    """A short content hash of files (the code a cached derivation depends on)."""
+    import hashlib
+
+    h = hashlib.sha256()
+    for path in paths:
+        h.update(Path(path).read_bytes())
+    return h.hexdigest()[:16]
+
+
 def cache_root() -> Path:
     """$COTM_CACHE or ~/.cache/cotm-bertini: derived equations, generic sets, solves, sweeps."""
     root = os.environ.get("COTM_CACHE") or Path.home() / ".cache" / "cotm-bertini"

@@ -8,7 +8,6 @@ source (equations.py, kinematics.py), so an edit of either regenerates them.
 
 from __future__ import annotations
 
-import hashlib
 import json
 import marshal
 import sys
@@ -18,19 +17,18 @@ from pathlib import Path
 
 import numpy as np
 
-from ..fs import atomic_write_bytes, atomic_write_text, cache_root
+from ..fs import atomic_write_bytes, atomic_write_text, cache_root, files_hash
 from ..params import Params
 from .polynomial import ParametricSystem, PolySystem
 
-_SOURCES = tuple(Path(__file__).resolve().parent / f for f in ("equations.py", "kinematics.py"))
+_SOURCES = tuple(
+    Path(__file__).resolve().parent / f for f in ("equations.py", "kinematics.py", "symbolic.py")
+)
 
 
 @cache
 def _source_hash() -> str:
-    h = hashlib.sha256()
-    for path in _SOURCES:
-        h.update(path.read_bytes())
-    return h.hexdigest()[:16]
+    return files_hash(_SOURCES)
 
 
 def _tag(zfl: tuple[bool, bool]) -> str:

@@ -10,6 +10,7 @@ from functools import cache, lru_cache
 from pathlib import Path
 
 from ...errors import ParameterError
+from ...fs import files_hash
 from .spec import Framework, owner
 from .units import constants
 
@@ -111,10 +112,7 @@ _SOURCES = tuple(
 @cache
 def source_hash() -> str:
     """A hash of the derivation's code: an edit derives every structure again."""
-    h = hashlib.sha256()
-    for path in _SOURCES:
-        h.update(path.read_bytes())
-    return h.hexdigest()[:16]
+    return files_hash(_SOURCES)
 
 
 @lru_cache(maxsize=256)

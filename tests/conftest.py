@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+import subprocess
 import sys
 from functools import cache
 from pathlib import Path
@@ -49,3 +51,17 @@ def solve(params, settings=None):
 def fixtures_dir() -> Path:
     """Real Bertini 1.6 output of the paper's three cases (tests/fixtures/bertini-1.6)."""
     return FIXTURES
+
+
+def run_cli(*args: str, env: dict | None = None, cwd: Path | None = None,
+            umask: int | None = None, timeout: float = 600):  # fmt: skip
+    """Run `cotm-bertini` as a user would, in a fresh process (optionally under a umask)."""
+    return subprocess.run(
+        [sys.executable, "-m", "cotm_bertini.cli", *args],
+        capture_output=True,
+        text=True,
+        env={**os.environ, **(env or {})},
+        cwd=cwd,
+        timeout=timeout,
+        preexec_fn=None if umask is None else (lambda: os.umask(umask)),
+    )

@@ -3,13 +3,11 @@
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pandas as pd
 import pytest
+from conftest import run_cli
 
 REQUIRED = [
     "solution_id",
@@ -29,14 +27,7 @@ REQUIRED = [
 
 def cli(*args: str, env: dict | None = None, cwd: Path | None = None):
     """Run `cotm-bertini` as a user would, in a fresh process."""
-    return subprocess.run(
-        [sys.executable, "-m", "cotm_bertini.cli", *args],
-        capture_output=True,
-        text=True,
-        env={**os.environ, **(env or {})},
-        cwd=cwd,
-        timeout=300,
-    )
+    return run_cli(*args, env=env, cwd=cwd, timeout=300)
 
 
 def test_solve_case1_writes_run_folder(tmp_path):

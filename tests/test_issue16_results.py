@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from conftest import run_cli
 
 import cotm_bertini as cb
 
@@ -27,15 +28,7 @@ ANNOUNCE = "solving the generic solution set"
 
 def cli(*args: str, env: dict | None = None, umask: int | None = None, cwd: Path | None = None):
     """Run `cotm-bertini` as a user would, in a fresh process (optionally under a umask)."""
-    return subprocess.run(
-        [sys.executable, "-m", "cotm_bertini.cli", *args],
-        capture_output=True,
-        text=True,
-        env={**os.environ, **(env or {})},
-        cwd=cwd,
-        timeout=600,
-        preexec_fn=None if umask is None else (lambda: os.umask(umask)),
-    )
+    return run_cli(*args, env=env, umask=umask, cwd=cwd)
 
 
 @pytest.fixture(scope="module")

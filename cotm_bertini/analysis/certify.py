@@ -37,6 +37,12 @@ METHODS = {
     "Krawczyk on grad V)",
     "torus": "Krawczyk (complex balls) per solution; branch and bound with Krawczyk on grad V "
     "over the torus",
+    "framework-torus": "Krawczyk (complex balls) per real solution on its taut set's system; "
+    "consistency and kind over the proved box (ball LDL^T of the bordered Hessian); "
+    "completeness: branch and bound with Krawczyk on grad V over the torus of body angles",
+    "framework-rows": "Krawczyk (complex balls) per real solution on its taut set's system; "
+    "consistency and kind over the proved box (ball LDL^T of the bordered Hessian); "
+    "completeness not proved",
 }
 
 
@@ -137,10 +143,10 @@ def certify_table(
         f"gamma2 {math.degrees(q[2]):.6f}..{math.degrees(q[3]):.6f} deg is not in the table"
         for q in proof.missing
     ]
-    contradictions += _duplicates(known)
+    contradictions += duplicates(known)
     found = {sid for sid, boxes in proof.roots.items() if boxes}
     contradictions += _unmatched_rows(params, table, found | set(), unproved, bound)
-    contradictions += _kind_differences(table, kinds)
+    contradictions += kind_differences(table, kinds)
     singular = np.asarray(table["singular"], dtype=bool)
     open_rows = int((~certified & ~singular).sum())
     undecided = bool(proof.undecided) or open_rows > 0 or "undecided" in kinds.values()
@@ -169,8 +175,9 @@ def _completeness(params: Params, known: list[Known], short: float, min_width: f
     return branch_and_bound(params, balls, short, min_width)
 
 
-def _duplicates(known: list[Known]) -> list[str]:
-    """Two rows proved in overlapping enclosures may be one equilibrium: a contradiction."""
+def duplicates(known: list[Known]) -> list[str]:
+    """Two rows proved in overlapping enclosures may be one equilibrium: a contradiction (any
+    number of angles)."""
 
     def centre_half(k: Known, j: int) -> tuple[float, float]:
         lo, hi = k.enclosure[2 * j], k.enclosure[2 * j + 1]
@@ -180,7 +187,7 @@ def _duplicates(known: list[Known]) -> list[str]:
     for n, a in enumerate(known):
         for b in known[n + 1 :]:
             overlap = True
-            for j in (0, 1):
+            for j in range(len(a.enclosure) // 2):
                 (ca, ha), (cb, hb) = centre_half(a, j), centre_half(b, j)
                 overlap &= abs((ca - cb + math.pi) % (2 * math.pi) - math.pi) <= ha + hb
             if overlap:
@@ -203,7 +210,7 @@ def _unmatched_rows(params, table, found: set, unproved: list, bound: float) -> 
     return out
 
 
-def _kind_differences(table, kinds: dict[int, str]) -> list[str]:
+def kind_differences(table, kinds: dict[int, str]) -> list[str]:
     out = []
     for row, sid in enumerate(np.asarray(table["solution_id"], dtype=int)):
         proved = kinds.get(int(sid))

@@ -39,9 +39,17 @@ def ball_system(params: Params) -> BallSystem:
     max(k) in ball arithmetic, so the rounding of the normalisation is accounted for)."""
     from flint import arb
 
-    ps = parametric_system(params.zfl)
     length, stiff = arb(params.L3), arb(max(params.k1, params.k2))
     values = {n: arb(getattr(params, n)) / (length if n in LENGTHS else stiff) for n in PARAM_NAMES}
+    return ball_system_of(parametric_system(params.zfl), values)
+
+
+def ball_system_of(ps, values: dict) -> BallSystem:
+    """A ParametricSystem with its parameters set to balls (`values`: name -> arb): the
+    coefficients become balls holding the true ones (the stored coefficients are exact: integers
+    and halves from the derivation, or the doubles it folded in)."""
+    from flint import arb
+
     terms = []
     for ve, pe, c in zip(ps.var_exps, ps.par_exps, ps.coeffs, strict=True):
         function = []
@@ -190,32 +198,49 @@ def certify_rows(params: Params, table) -> tuple[np.ndarray, np.ndarray]:
     real = np.asarray(table["is_real"], dtype=bool)
     points = np.where(real[:, None], re + 0j, re + 1j * im) / scale
     todo = np.flatnonzero(~np.asarray(table["singular"], dtype=bool))
-    near = _newton(numeric, points[todo]) if len(todo) else points[todo]
-    near[real[todo]] = near[real[todo]].real
-    n = len(variables)
-    jacs = numeric.jacobian(near) if len(todo) else np.zeros((0, n, n))
+    proved = np.zeros(len(points), dtype=bool)
+    radius = np.full(len(points), np.nan)
+    proved[todo], radius[todo], _ = certify_points(
+        lambda: ball_system(params), numeric, points[todo], real[todo]
+    )
+    return proved, radius
+
+
+def certify_points(make_system, numeric, points: np.ndarray, real: np.ndarray) -> tuple:
+    """Krawczyk around each point of a polynomial system (normalised units): (proved, box
+    half-width or NaN, the proved centres as acb lists or None). `make_system()` builds the
+    BallSystem (at the working precision); `numeric`: the same system in double precision
+    (evaluate, jacobian) for the Newton refinement of the starts."""
+    from flint import ctx
+
+    near = _newton(numeric, points) if len(points) else points
+    near[real] = near[real].real
+    n = points.shape[1] if points.ndim == 2 else 0
+    jacs = numeric.jacobian(near) if len(points) else np.zeros((0, n, n))
     invertible = np.isfinite(jacs).all(axis=(1, 2)) & (np.abs(np.linalg.det(jacs)) > 1e-300)
     inverses = np.zeros_like(jacs)
     inverses[invertible] = np.linalg.inv(jacs[invertible])
     proved = np.zeros(len(points), dtype=bool)
     radius = np.full(len(points), np.nan)
-    from flint import ctx
-
+    centres: list = [None] * len(points)
     bits, ctx.prec = ctx.prec, WORKING_BITS
     try:
-        system = ball_system(params)
-        for row, start, y, ok in zip(todo, near, inverses, invertible, strict=True):
+        system = make_system() if len(points) else None
+        for row, (start, y, ok) in enumerate(zip(near, inverses, invertible, strict=True)):
             if ok:
-                proved[row], radius[row] = _prove(system, points[row], start, y, real[row])
+                proved[row], radius[row], centres[row] = _prove(
+                    system, points[row], start, y, real[row]
+                )
     finally:
         ctx.prec = bits
-    return proved, radius
+    return proved, radius, centres
 
 
 def _prove(system: BallSystem, c: np.ndarray, start: np.ndarray, y: np.ndarray,
-           real: bool) -> tuple[bool, float]:  # fmt: skip
-    """(proved, box half-width) for one row: the double-precision centre first, then one
-    Newton step in ball arithmetic with each radius in turn (an ill-conditioned root)."""
+           real: bool) -> tuple[bool, float, list | None]:  # fmt: skip
+    """(proved, box half-width, the box's centre) for one row: the double-precision centre
+    first, then one Newton step in ball arithmetic with each radius in turn (an
+    ill-conditioned root)."""
     scale = 1 + float(np.abs(c).max())
     for steps, radii in ((0, RADII[:1]), (1, RADII)):
         prepared = prepare(system, y, c, start, steps)
@@ -223,5 +248,5 @@ def _prove(system: BallSystem, c: np.ndarray, start: np.ndarray, y: np.ndarray,
             if not real and (np.abs(c.imag) <= r).all():
                 continue  # this box would reach the real space: no proof of non-realness
             if krawczyk(system, prepared, r):
-                return True, r
-    return False, float("nan")
+                return True, r, prepared.centre
+    return False, float("nan"), None

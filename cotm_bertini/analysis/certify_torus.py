@@ -1,19 +1,25 @@
-"""Completeness, proved: every critical point of V on the torus, by branch and bound in ball
-arithmetic (python-flint's arb), outside small neighbourhoods of the zero-length points.
+"""Completeness, proved: every critical point of V on a torus of angles (a circle: one angle),
+by branch and bound in ball arithmetic (python-flint's arb), outside small neighbourhoods of the
+zero-length points.
 
-Each box of angles is either excluded (an interval enclosure of grad V misses 0), or shown by the
-Krawczyk operator to hold exactly one critical point (K(Q) in the interior of Q) or none (K(Q)
-misses Q), or split. V is not smooth where a spring with L0 > 0 has zero length: boxes where
-such a spring is certainly shorter than `short` are set aside, and so are boxes where it may be,
-once split down to `min_width`; the proof bounds the spring length over every box set aside, so
-the statement is: every critical point with both spring lengths above that bound is found. A box
-with one critical point is matched to the known equilibrium
-whose proved enclosure it contains; one with no known equilibrium in it is a missing one.
+V is given by a `Landscape`: enclosures of its gradient and Hessian over a box of angles, and of
+the squared lengths of the springs with free lengths (the paper's mechanism: `paper_landscape`;
+a framework whose poses form a torus: analysis.certify_framework). Each box of angles is either
+excluded (an interval enclosure of grad V misses 0), or shown by the Krawczyk operator to hold
+exactly one critical point (K(Q) in the interior of Q) or none (K(Q) misses Q), or split. V is
+not smooth where a spring with L0 > 0 has zero length: boxes where such a spring is certainly
+shorter than `short` are set aside, and so are boxes where it may be, once split down to
+`min_width`; the proof bounds the spring length over every box set aside, so the statement is:
+every critical point with every spring length above that bound is found. A box with one critical
+point is matched to the known equilibrium whose proved enclosure it contains; one with no known
+equilibrium in it is a missing one. Boxes are flat tuples (lo1, hi1, lo2, hi2, ...) in radians.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from types import SimpleNamespace
 
@@ -26,6 +32,19 @@ TWO_PI = 2 * math.pi
 ROOT_MIN_WIDTH = 1e-10  # boxes holding a known equilibrium's enclosure are split down to this
 
 
+@dataclass(frozen=True)
+class Landscape:
+    """V on the torus of `n` angles, as ball enclosures over a box (a tuple of n arb balls):
+    `enclose(balls, hessian)` -> (grad V, its Hessian or None), `lengths(balls)` -> the squared
+    lengths of the springs with free lengths (V is not smooth where one is 0); `length_unit`:
+    the unit of those lengths (the smallest box worth splitting to scales with it)."""
+
+    n: int
+    enclose: Callable
+    lengths: Callable
+    length_unit: float
+
+
 def arb_params(params: Params):
     """The parameters as exact balls (a float is an exact binary number)."""
     from flint import arb
@@ -33,11 +52,11 @@ def arb_params(params: Params):
     return SimpleNamespace(**{n: arb(getattr(params, n)) for n in PARAM_NAMES})
 
 
-def box(lo1: float, hi1: float, lo2: float, hi2: float) -> tuple:
-    """Balls holding [lo1, hi1] x [lo2, hi2] exactly."""
+def box(*bounds: float) -> tuple:
+    """Balls holding [lo1, hi1] x [lo2, hi2] x ... exactly."""
     from flint import arb
 
-    return arb(lo1).union(arb(hi1)), arb(lo2).union(arb(hi2))
+    return tuple(arb(lo).union(arb(hi)) for lo, hi in zip(bounds[::2], bounds[1::2], strict=True))
 
 
 def enclosures(pa, g1, g2, hessian: bool = True):
@@ -61,30 +80,46 @@ class TorusProof:
     notes: list[str] = field(default_factory=list)
 
 
+def paper_landscape(params: Params, pa=None) -> Landscape:
+    """The paper's mechanism: V(gamma1, gamma2) of its two springs."""
+    pa = pa or arb_params(params)
+    return Landscape(
+        2,
+        lambda balls, hessian=True: enclosures(pa, *balls, hessian=hessian),
+        lambda balls: spring_length_squares(params, pa, *balls),
+        params.L3,
+    )
+
+
 def krawczyk_2d(params: Params, pa, q: tuple[float, float, float, float]) -> tuple[str, tuple]:
+    """`krawczyk_box` for the paper's mechanism."""
+    return krawczyk_box(paper_landscape(params, pa), q)
+
+
+def krawczyk_box(land: Landscape, q: tuple) -> tuple[str, tuple]:
     """('one', K) (exactly one critical point in the box, and it lies in K), ('none', K), or
-    ('unknown', K); K is the Krawczyk image of the box."""
+    ('unknown', K); K is the Krawczyk image of the box (arb balls)."""
     from flint import arb, arb_mat
 
-    lo1, hi1, lo2, hi2 = q
-    m = ((lo1 + hi1) / 2, (lo2 + hi2) / 2)
-    g1, g2 = box(*q)
-    grad_m, _ = enclosures(pa, arb(m[0]), arb(m[1]), hessian=False)
-    _, hq = enclosures(pa, g1, g2)
+    n = land.n
+    m = [(q[2 * j] + q[2 * j + 1]) / 2 for j in range(n)]
+    balls = box(*q)
+    grad_m, _ = land.enclose(tuple(arb(v) for v in m), hessian=False)
+    _, hq = land.enclose(balls)
     # The preconditioner: the inverse of the Hessian's midpoint (any matrix is sound here).
     h_mid = np.array([[float(h.mid()) for h in row] for row in hq])
     if not np.isfinite(h_mid).all() or abs(np.linalg.det(h_mid)) < 1e-300:
         return "unknown", ()
     y = np.linalg.inv(h_mid)
-    ym = arb_mat([[arb(float(y[i, j])) for j in (0, 1)] for i in (0, 1)])
-    hm = arb_mat([[hq[0][0], hq[0][1]], [hq[1][0], hq[1][1]]])
-    step = ym * arb_mat([[grad_m[0]], [grad_m[1]]])
-    spread = (arb_mat([[1, 0], [0, 1]]) - ym * hm) * arb_mat([[g1 - m[0]], [g2 - m[1]]])
-    k = [arb(m[j]) - step[j, 0] + spread[j, 0] for j in (0, 1)]
-    q_balls = (g1, g2)
-    if all(q_balls[j].contains_interior(k[j]) for j in (0, 1)):
+    ym = arb_mat([[arb(float(y[i, j])) for j in range(n)] for i in range(n)])
+    hm = arb_mat([list(row) for row in hq])
+    step = ym * arb_mat([[g] for g in grad_m])
+    ident = arb_mat([[1 if i == j else 0 for j in range(n)] for i in range(n)])
+    spread = (ident - ym * hm) * arb_mat([[balls[j] - m[j]] for j in range(n)])
+    k = [arb(m[j]) - step[j, 0] + spread[j, 0] for j in range(n)]
+    if all(balls[j].contains_interior(k[j]) for j in range(n)):
         return "one", tuple(k)
-    if any(not q_balls[j].overlaps(k[j]) for j in (0, 1)):
+    if any(not balls[j].overlaps(k[j]) for j in range(n)):
         return "none", tuple(k)
     return "unknown", tuple(k)
 
@@ -93,24 +128,24 @@ def _close(centres: np.ndarray, q: tuple, margin: float) -> bool:
     """Whether a known equilibrium lies within `margin` of the box (on the torus)."""
     if not len(centres):
         return False
-    mid = np.array([(q[0] + q[1]) / 2, (q[2] + q[3]) / 2])
-    half = np.array([(q[1] - q[0]) / 2, (q[3] - q[2]) / 2])
+    mid = np.array([(q[2 * j] + q[2 * j + 1]) / 2 for j in range(len(q) // 2)])
+    half = np.array([(q[2 * j + 1] - q[2 * j]) / 2 for j in range(len(q) // 2)])
     gap = np.abs((centres - mid + math.pi) % TWO_PI - math.pi) - half
     return bool((gap.max(axis=1) <= margin).any())
 
 
-def enclosure_bounds(known: dict[int, tuple]) -> tuple[list[int], np.ndarray]:
+def enclosure_bounds(known: dict[int, tuple], n: int = 2) -> tuple[list[int], np.ndarray]:
     """The known enclosures as float bounds, rounded outwards, with their copies one turn away:
-    (indices, array (n, 9, 4) of lo1, hi1, lo2, hi2)."""
+    (indices, array (known, 3^n, 2n) of lo1, hi1, lo2, hi2, ...)."""
     keys = list(known)
-    out = np.zeros((len(keys), 9, 4))
+    shifts = list(itertools.product((-1, 0, 1), repeat=n))
+    out = np.zeros((len(keys), len(shifts), 2 * n))
     for a, k in enumerate(keys):
-        e1, e2 = known[k]
-        lo = [math.nextafter(float(e.lower()), -math.inf) for e in (e1, e2)]
-        hi = [math.nextafter(float(e.upper()), math.inf) for e in (e1, e2)]
-        for b, (s1, s2) in enumerate((s1, s2) for s1 in (-1, 0, 1) for s2 in (-1, 0, 1)):
-            sh1, sh2 = s1 * TWO_PI, s2 * TWO_PI
-            out[a, b] = (lo[0] + sh1, hi[0] + sh1, lo[1] + sh2, hi[1] + sh2)
+        lo = [math.nextafter(float(e.lower()), -math.inf) for e in known[k]]
+        hi = [math.nextafter(float(e.upper()), math.inf) for e in known[k]]
+        for b, shift in enumerate(shifts):
+            for j, s in enumerate(shift):
+                out[a, b, 2 * j : 2 * j + 2] = (lo[j] + s * TWO_PI, hi[j] + s * TWO_PI)
     return keys, out
 
 
@@ -122,8 +157,12 @@ def _where(bounds: tuple[list[int], np.ndarray], q: tuple) -> tuple[list[int], l
     keys, b = bounds
     if not keys:
         return [], []
-    inside = (q[0] < b[..., 0]) & (b[..., 1] < q[1]) & (q[2] < b[..., 2]) & (b[..., 3] < q[3])
-    touch = (b[..., 0] <= q[1]) & (q[0] <= b[..., 1]) & (b[..., 2] <= q[3]) & (q[2] <= b[..., 3])
+    inside = np.ones(b.shape[:2], dtype=bool)
+    touch = np.ones(b.shape[:2], dtype=bool)
+    for j in range(len(q) // 2):
+        lo, hi = q[2 * j], q[2 * j + 1]
+        inside &= (lo < b[..., 2 * j]) & (b[..., 2 * j + 1] < hi)
+        touch &= (b[..., 2 * j] <= hi) & (lo <= b[..., 2 * j + 1])
     ins, tou = inside.any(axis=1), touch.any(axis=1)
     return [keys[a] for a in np.flatnonzero(ins)], [keys[a] for a in np.flatnonzero(tou & ~ins)]
 
@@ -150,9 +189,13 @@ def _short(lengths: list, limit) -> str:
 
 
 def _split(q: tuple) -> list[tuple]:
-    lo1, hi1, lo2, hi2 = q
-    m1, m2 = (lo1 + hi1) / 2, (lo2 + hi2) / 2
-    return [(lo1, m1, lo2, m2), (m1, hi1, lo2, m2), (lo1, m1, m2, hi2), (m1, hi1, m2, hi2)]
+    """The 2^n halves-in-every-angle of a box."""
+    halves = []
+    for j in range(len(q) // 2):
+        lo, hi = q[2 * j], q[2 * j + 1]
+        mid = (lo + hi) / 2
+        halves.append(((lo, mid), (mid, hi)))
+    return [tuple(v for pair in choice for v in pair) for choice in itertools.product(*halves)]
 
 
 def branch_and_bound(
@@ -162,28 +205,39 @@ def branch_and_bound(
     min_width: float,
     start: int = 16,
 ) -> TorusProof:
-    """Decide every box of the torus [0, 2 pi]^2 (see the module docstring). Boxes where a
+    """`torus_search` for the paper's mechanism."""
+    return torus_search(paper_landscape(params), known, short, min_width, start)
+
+
+def torus_search(
+    land: Landscape,
+    known: dict[int, tuple],
+    short: float,
+    min_width: float,
+    start: int = 16,
+) -> TorusProof:
+    """Decide every box of the torus [0, 2 pi]^n (see the module docstring). Boxes where a
     spring with L0 > 0 is shorter than `short` are set aside (split to `min_width` where they
     may only be); `proof.longest_excluded` bounds the spring length over them."""
     from flint import arb
 
-    pa = arb_params(params)
     zero, limit = arb(0), arb(short) ** 2
     # At the smallest width, a spring this short still makes the enclosures of the 1/d terms
     # too wide to decide: such boxes are set aside too (the reported bound covers them).
-    wide = (arb(short) + 3 * pa.L3 * arb(min_width)) ** 2
+    wide = (arb(short) + 3 * arb(land.length_unit) * arb(min_width)) ** 2
     proof = TorusProof({k: [] for k in known}, [], [], [])
-    centres = np.array([[float(e[0].mid()), float(e[1].mid())] for e in known.values()])
-    bounds = enclosure_bounds(known)
+    centres = np.array([[float(e.mid()) for e in v] for v in known.values()])
+    bounds = enclosure_bounds(known, land.n)
     edges = np.linspace(0.0, TWO_PI, start + 1)
-    stack = [(a, b, c, d) for a, b in zip(edges[:-1], edges[1:], strict=True)
-             for c, d in zip(edges[:-1], edges[1:], strict=True)]  # fmt: skip
+    cells = list(zip(edges[:-1], edges[1:], strict=True))
+    stack = [tuple(v for c in choice for v in c) for choice in itertools.product(cells,
+             repeat=land.n)]  # fmt: skip
     while stack:
         q = stack.pop()
         proof.boxes += 1
-        g1, g2 = box(*q)
-        width = max(q[1] - q[0], q[3] - q[2])
-        lengths = spring_length_squares(params, pa, g1, g2)
+        balls = box(*q)
+        width = max(q[2 * j + 1] - q[2 * j] for j in range(land.n))
+        lengths = land.lengths(balls)
         near = _short(lengths, limit if width > min_width else wide)
         if near == "all" or (near and width <= min_width):
             proof.excluded.append(q)
@@ -191,10 +245,10 @@ def branch_and_bound(
             proof.longest_excluded = max(proof.longest_excluded, math.sqrt(shortest))
             continue
         if not near:
-            grad, _ = enclosures(pa, g1, g2, hessian=False)
-            if not (grad[0].contains(zero) and grad[1].contains(zero)):
+            grad, _ = land.enclose(balls, hessian=False)
+            if not all(g.contains(zero) for g in grad):
                 continue
-            verdict, _k = krawczyk_2d(params, pa, q)
+            verdict, _k = krawczyk_box(land, q)
             if verdict == "none":
                 continue
             inside, partial = _where(bounds, q)
@@ -209,7 +263,7 @@ def branch_and_bound(
             if (inside or partial or _close(centres, q, 4 * min_width)) and width > ROOT_MIN_WIDTH:
                 stack.extend(_split(q))
                 continue
-        if width <= _floor(lengths, min_width, params.L3):
+        if width <= _floor(lengths, min_width, land.length_unit):
             proof.undecided.append(q)
             continue
         stack.extend(_split(q))

@@ -1,0 +1,389 @@
+"""The certificate of a framework's solve (docs/certify.md, "Frameworks").
+
+1. Each real row: the solver's variables recovered from the row (pose, lengths, tensions; the
+   multipliers the table does not list by a least-squares solve, exact since the equations are
+   affine in them), then Krawczyk in ball arithmetic on its taut set's own polynomial system
+   (`certify_roots`, the same code as for the paper's mechanism), the parameters entering as
+   balls that hold the file's values in the framework's units.
+2. Each proved physical row: its consistency (every length variable > 0, a taut cable longer
+   than its free length, a slack one shorter) and its kind (the inertia of the reduced Hessian,
+   `certify_inertia`) over the proved box.
+3. Where the poses form a circle or a torus and no cable makes V piecewise: completeness by the
+   branch and bound of `certify_torus` on V in the body angles, enclosed by the derivation's own
+   generated code evaluated on balls (model.framework.ballcode).
+Elsewhere the certificate says what is proved (the rows) and that completeness is not.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..model.framework.ballcode import ball_module
+from ..model.framework.compiled import FrameworkSystem, framework_system, variable_scale
+from ..model.framework.spec import Framework
+from ..model.framework.structure import layout
+from ..model.framework.units import normalized_slots, slot_kind, units
+from .certify import Certificate, duplicates, kind_differences
+from .certify_inertia import reduced_kind
+from .certify_roots import WORKING_BITS, ball_system_of, certify_points
+from .certify_search import Known
+from .certify_torus import Landscape, krawczyk_box, torus_search
+
+SHORT = 1e-3  # springs shorter than this (framework length units) are set aside at cone points
+MIN_WIDTH = 1e-4  # radians: the smallest box away from a known equilibrium
+ROOT_BOX = 1e-7  # radians: the half-width of the box proving each equilibrium in the angles
+SLOT_RADIUS = 2.0**-50  # relative radius of a slot's ball: holds the decimal the file wrote
+
+
+def slot_balls(fw: Framework) -> list:
+    """Every slot in the framework's units as a ball holding the file's value (the double of a
+    decimal, or of an expression of decimals, is within a few roundings of it), in slot order."""
+    from flint import arb
+
+    length, stiffness = (arb(u) for u in units(fw))
+    unit = {"len": length, "k": stiffness, "force": stiffness * length}
+    return [
+        (arb(v, abs(v) * SLOT_RADIUS) if v else arb(0)) / unit[slot_kind(name)]
+        for name, v in fw.slots().items()
+    ]
+
+
+def _ball(v):
+    from flint import arb
+
+    return v if isinstance(v, arb) else arb(v)
+
+
+@dataclass
+class _Rows:
+    """What part 1 and 2 established, per row of the table."""
+
+    certified: np.ndarray
+    radius: np.ndarray
+    physical: dict[int, str] = field(default_factory=dict)  # row -> yes, no, unknown
+    kinds: dict[int, str] = field(default_factory=dict)  # solution_id -> proved kind
+
+
+def _row_points(fw: Framework, fs: FrameworkSystem, table, rows: np.ndarray) -> tuple:
+    """(the solver's variables of real rows, normalised; the numeric system): rotations from
+    the angles (or quaternions), translations, nodes, lengths d, force densities w = tension / d
+    and bar multipliers tension / length from the columns; then every w and mu (the pins'
+    multipliers are not in the table) by least squares: the equations are affine in them."""
+    cols = {}
+    for v in fs.ps.variables:
+        head, _, rest = v.partition("_")
+        column = None
+        if head in ("c", "s"):
+            angle = np.radians(np.asarray(table[f"{rest}.angle_deg"], float)[rows])
+            cols[v] = np.cos(angle) if head == "c" else np.sin(angle)
+        elif head.startswith("q"):
+            column = f"{rest}.q{head[1]}"
+        elif head in ("t", "n"):
+            owner, axis = rest.rsplit("_", 1)
+            column = f"{owner}.{axis}"
+        elif head == "d":
+            column = f"{rest}.length"
+        elif head in ("w", "mu") and f"{rest}.tension" in table:
+            cols[v] = np.asarray(table[f"{rest}.tension"], float)[rows] / np.asarray(
+                table[f"{rest}.length"], float)[rows]  # fmt: skip
+        if column is not None:
+            cols[v] = np.asarray(table[column], float)[rows]
+        cols.setdefault(v, np.zeros(len(rows)))
+    x = np.column_stack([cols[v] for v in fs.ps.variables]) / variable_scale(fs, units(fw))
+    slots = normalized_slots(fw)
+    system = fs.ps.instantiate([slots[n] for n in fs.ps.parameters])
+    linear = [j for j, k in enumerate(fs.kinds) if k in ("k", "force")]
+    for i in range(len(x) if linear else 0):
+        jac = system.jacobian(x[i : i + 1])[0][:, linear].real
+        rhs = -system.evaluate(x[i : i + 1])[0].real
+        x[i, linear] += np.linalg.lstsq(jac, rhs, rcond=None)[0]
+    return np.nan_to_num(x).astype(complex), system
+
+
+def certify_rows(fw: Framework, table, P: list) -> _Rows:
+    """Parts 1 and 2 for every row (rows by position): proved, box half-width (normalised),
+    and for the proved physical ones consistency and kind."""
+    n = len(table["solution_id"])
+    out = _Rows(np.zeros(n, dtype=bool), np.full(n, np.nan))
+    real = np.asarray(table["is_real"], dtype=bool)
+    singular = np.asarray(table["singular"], dtype=bool)
+    sets = np.asarray(table["taut_set"], dtype=object)
+    names = {p: ball for p, ball in zip(fw.slots(), P, strict=True)}
+    for label in sorted(set(sets)):
+        rows = np.flatnonzero((sets == label) & real & ~singular)
+        if not len(rows):
+            continue
+        fs = framework_system(fw, tuple(label.split()))
+        points, system = _row_points(fw, fs, table, rows)
+        proved, radius, centres = certify_points(
+            lambda fs=fs: ball_system_of(fs.ps, names), system, points, np.ones(len(rows), bool)
+        )
+        out.certified[rows], out.radius[rows] = proved, radius
+        for row, ok, r, centre in zip(rows, proved, radius, centres, strict=True):
+            if ok:
+                _judge(fw, fs, table, int(row), [_real_ball(z, r) for z in centre], P, out)
+    return out
+
+
+def _real_ball(z, r: float):
+    """The real ball of half-width r about a proved real centre: the root is real and in the
+    complex box, so it lies in this ball."""
+    from flint import arb
+
+    return arb(z.real.mid(), r)
+
+
+def _judge(fw, fs, table, row: int, X: list, P: list, out: _Rows) -> None:
+    """Consistency and kind of one proved real row over its box X."""
+    from flint import ctx
+
+    bits, ctx.prec = ctx.prec, WORKING_BITS
+    try:
+        out.physical[row] = consistency(fw, fs, X, P)
+        if out.physical[row] == "yes":
+            code, m = ball_module(fs), fs.local_size
+            h = [_ball(v) for v in code.hessian(X, P)]
+            g = [_ball(v) for v in code.constraint_jacobian(X, P)] if fs.constraints else []
+            H = [h[i * m : (i + 1) * m] for i in range(m)]
+            G = [g[i * m : (i + 1) * m] for i in range(len(g) // m)] if g else []
+            out.kinds[int(table["solution_id"][row])] = reduced_kind(H, G)
+    finally:
+        ctx.prec = bits
+
+
+def consistency(fw: Framework, fs: FrameworkSystem, X: list, P: list) -> str:
+    """'yes' when the box X proves the row physical (each length variable > 0, each taut cable
+    longer than its free length, each slack one shorter), 'no' when it proves it is not,
+    'unknown' otherwise."""
+    index = {v: j for j, v in enumerate(fs.ps.variables)}
+    slot = {n: j for j, n in enumerate(fw.slots())}
+    pos = ball_module(fs).positions(X, P)
+    where = {p: pos[k * fw.dim : (k + 1) * fw.dim] for k, p in enumerate(fs.points)}
+    verdicts = []
+    for x in fw.links:
+        if x.kind == "bar" or (x.kind == "spring" and f"d_{x.name}" not in index):
+            continue  # a bar, or a spring of zero free length: no condition
+        L0 = P[slot[f"L0_{x.name}"]]
+        if f"d_{x.name}" in index:
+            d = X[index[f"d_{x.name}"]]
+        else:
+            r = [_ball(a) - _ball(b) for a, b in zip(where[x.a], where[x.b], strict=True)]
+            dd = sum((c * c for c in r[1:]), r[0] * r[0])
+            d = dd.sqrt() if dd > 0 else dd  # only its sign matters where it may be 0
+        if x.kind == "spring":
+            lo, hi = 0, None
+        else:
+            lo, hi = (L0, None) if x.name in fs.taut else (None, L0)
+        above = lo is None or d > lo
+        below = hi is None or d < hi
+        wrong = (lo is not None and d < lo) or (hi is not None and d > hi)
+        verdicts.append("yes" if above and below else "no" if wrong else "unknown")
+    return "no" if "no" in verdicts else "unknown" if "unknown" in verdicts else "yes"
+
+
+def torus_landscape(fw: Framework, fs: FrameworkSystem, P: list) -> Landscape:
+    """V of a framework whose poses form a torus (only body rotations), in the body angles:
+    grad V = sum k (1 - L0 / |r|) r . dr/dangle (k r . dr/dangle at zero free length) plus the
+    loads' gradient, from the generated `first_order`; the Hessian from `hessian`."""
+    from flint import arb
+
+    code, m, dim = ball_module(fs), fs.local_size, fw.dim
+    index = {v: j for j, v in enumerate(fs.ps.variables)}
+    rot = [(index[f"c_{b}"], index[f"s_{b}"]) for b in layout(fw).rotations]
+    slot = {n: P[j] for j, n in enumerate(fw.slots())}
+    zfl = set(fw.zero_free_length())
+    links = [(slot[f"k_{x}"], None if x in zfl else slot[f"L0_{x}"]) for x in fs.active]
+    zero = arb(0)
+
+    def pose(balls) -> list:
+        X = [zero] * len(fs.ps.variables)
+        for (c, s), a in zip(rot, balls, strict=True):
+            X[s], X[c] = a.sin_cos()
+        return X
+
+    def parts(balls) -> list:
+        first, per = code.first_order(pose(balls), P), dim + dim * m
+        out = []
+        for i, (k, L0) in enumerate(links):
+            r, dr = first[i * per : i * per + dim], first[i * per + dim : (i + 1) * per]
+            dd = sum((_ball(c) * c for c in r[1:]), _ball(r[0]) * r[0])
+            a = [sum(_ball(r[c]) * dr[c * m + j] for c in range(dim)) for j in range(m)]
+            out.append((k, L0, dd, a))
+        return out, first[len(links) * per :]
+
+    def enclose(balls, hessian: bool = True):
+        springs, loads = parts(balls)
+        grad = [_ball(v) for v in loads]
+        for k, L0, dd, a in springs:
+            w = k if L0 is None else k * (1 - L0 / dd.sqrt())
+            grad = [g + w * aj for g, aj in zip(grad, a, strict=True)]
+        if not hessian:
+            return grad, None
+        h = [_ball(v) for v in code.hessian(pose(balls), P)]
+        return grad, [h[i * m : (i + 1) * m] for i in range(m)]
+
+    def lengths(balls) -> list:
+        return [dd for _, L0, dd, _ in parts(balls)[0] if L0 is not None]
+
+    return Landscape(m, enclose, lengths, 1.0)
+
+
+def _completeness_scope(fw: Framework) -> str:
+    """'' when the branch and bound applies, else why completeness is not proved."""
+    lay = layout(fw)
+    if fw.dim != 2 or not lay.is_torus:
+        return "the configuration space is not a circle or torus"
+    if fw.cables:
+        return "cables make V piecewise (max(d - L0, 0)), which the branch and bound does not treat"
+    return ""
+
+
+def certify_framework_table(
+    fw: Framework, table, short: float = SHORT, min_width: float = MIN_WIDTH
+) -> Certificate:
+    """Prove each real row of a framework's solutions table, the consistency and kind of its
+    physical rows and, where the poses form a circle or torus, the completeness of the physical
+    set (module docstring). `table`: rows by position."""
+    from flint import ctx
+
+    start = time.perf_counter()
+    bits, ctx.prec = ctx.prec, WORKING_BITS
+    try:
+        P = slot_balls(fw)
+    finally:
+        ctx.prec = bits
+    rows = certify_rows(fw, table, P)
+    t_rows = time.perf_counter()
+    contradictions = _row_contradictions(table, rows)
+    scope = _completeness_scope(fw)
+    proof = None
+    if not scope:
+        land = torus_landscape(fw, framework_system(fw, ()), P)
+        known, unproved = _known(fw, table, land)
+        t_known = time.perf_counter()
+        balls = {k.sid: _enclosure_balls(k.enclosure) for k in known}
+        proof = torus_search(land, balls, short, min_width)
+        contradictions += _search_contradictions(fw, table, proof, known, unproved)
+    else:
+        t_known = t_rows
+    t_done = time.perf_counter()
+    status, statement = _verdict(table, rows, proof, scope, contradictions, units(fw)[0])
+    found = {sid for sid, boxes in proof.roots.items() if boxes} if proof else set()
+    timings = {"rows": t_rows - start, "equilibria": t_known - t_rows,
+               "completeness": t_done - t_known}  # fmt: skip
+    return Certificate(
+        status, statement, rows.certified, rows.radius, len(found), rows.kinds,
+        proof.longest_excluded * units(fw)[0] if proof else 0.0,
+        proof.boxes if proof else 0, len(proof.excluded) if proof else 0,
+        proof.undecided if proof else [], contradictions, time.perf_counter() - start, timings,
+        "framework-rows" if scope else "framework-torus",
+    )  # fmt: skip
+
+
+def _enclosure_balls(bounds: tuple) -> tuple:
+    from .certify_torus import box
+
+    return box(*bounds)
+
+
+def _known(fw: Framework, table, land: Landscape) -> tuple[list[Known], list[int]]:
+    """Each physical row proved a critical point of V in a tiny box of its body angles: (the
+    proved ones, the solution ids not proved)."""
+    known, failed = [], []
+    bodies = layout(fw).rotations
+    for row in np.flatnonzero(np.asarray(table["physical"], dtype=bool)):
+        sid = int(table["solution_id"][row])
+        angles = [math.radians(float(table[f"{b}.angle_deg"][row])) for b in bodies]
+        q = tuple(v for a in angles for v in (a - ROOT_BOX, a + ROOT_BOX))
+        verdict, image = krawczyk_box(land, q)
+        if verdict != "one":
+            failed.append(sid)
+            continue
+        bounds = []
+        for e in image:
+            bounds += [math.nextafter(float(e.lower()), -math.inf),
+                       math.nextafter(float(e.upper()), math.inf)]  # fmt: skip
+        known.append(Known(sid, q, tuple(bounds)))
+    return known, failed
+
+
+def _row_contradictions(table, rows: _Rows) -> list[str]:
+    """Rows whose proved consistency or kind differs from the table."""
+    out = []
+    physical = np.asarray(table["physical"], dtype=bool)
+    for row, verdict in rows.physical.items():
+        sid = int(table["solution_id"][row])
+        if verdict == "no" and physical[row]:
+            out.append(f"solution {sid} is in the table as physical, but its proved box "
+                       "breaks a length condition (a length <= 0 or a cable on the wrong side "
+                       "of its free length)")  # fmt: skip
+        elif verdict == "yes" and not physical[row]:
+            out.append(f"solution {sid} is proved a real, consistent equilibrium, but the "
+                       "table does not list it as physical")  # fmt: skip
+    return out + kind_differences(table, rows.kinds)
+
+
+def _search_contradictions(fw, table, proof, known: list[Known], unproved: list[int]) -> list:
+    """Critical points the table lacks, overlapping proofs, physical rows not found."""
+    out = []
+    for q in proof.missing:
+        where = ", ".join(f"{b} {math.degrees(q[2 * j]):.6f}..{math.degrees(q[2 * j + 1]):.6f}"
+                          for j, b in enumerate(layout(fw).rotations))  # fmt: skip
+        out.append(f"a critical point of V at {where} deg is not in the table")
+    out += duplicates(known)
+    found = {sid for sid, boxes in proof.roots.items() if boxes}
+    bound = proof.longest_excluded * units(fw)[0]
+    free = [x.name for x in fw.springs if x.name not in set(fw.zero_free_length())]
+    for row in np.flatnonzero(np.asarray(table["physical"], dtype=bool)):
+        sid = int(table["solution_id"][row])
+        lengths = [float(table[f"{n}.length"][row]) for n in free]
+        if sid in found or (lengths and min(lengths) <= bound):
+            continue
+        why = "its box failed the Krawczyk test" if sid in unproved else "no box holds it"
+        out.append(f"solution {sid} is in the table as physical but not proved ({why})")
+    return out
+
+
+def _verdict(table, rows: _Rows, proof, scope: str, contradictions: list, length: float):
+    """(status, statement): 'contradiction', 'undecided', 'proved' (rows and completeness) or
+    'rows proved' (every real row proved; completeness not proved: `scope` says why)."""
+    real = np.asarray(table["is_real"], dtype=bool)
+    singular = np.asarray(table["singular"], dtype=bool)
+    sids = np.asarray(table["solution_id"], dtype=int)
+    open_rows = sids[real & ~singular & ~rows.certified].tolist()
+    unsure = [int(sids[r]) for r, v in rows.physical.items() if v == "unknown"]
+    unsure += [sid for sid, kind in rows.kinds.items() if kind == "undecided"]
+    undecided = bool(open_rows or unsure or (proof is not None and proof.undecided))
+    n_phys = sum(1 for v in rows.physical.values() if v == "yes")
+    tail = (f"{int(rows.certified.sum())} of {len(sids)} solutions certified "
+            f"({int(singular.sum())} singular double roots cannot be; "
+            f"{int((~real & ~singular).sum())} complex rows not tried: the table keeps their "
+            "real parts only)")  # fmt: skip
+    if open_rows or unsure:
+        tail += f"; not proved: solutions {sorted(set(open_rows + unsure))}"
+    if proof is None:
+        status = "contradiction" if contradictions else "undecided" if undecided else "rows proved"
+        text = ("proved: every certified solution is a true isolated solution of its taut set's "
+                f"system within certified_radius; {n_phys} physical (consistency and stability "
+                f"proved); completeness not proved: {scope}")  # fmt: skip
+        if status == "contradiction":
+            text = "CONTRADICTION: the table and the proof differ"
+        return status, f"{text}; {tail}"
+    found = sum(1 for boxes in proof.roots.values() if boxes)
+    bound = proof.longest_excluded * length
+    where = (f"with every spring longer than {bound:.3g}" if bound > 0
+             else "(no spring with a free length reaches zero length)")  # fmt: skip
+    status = "contradiction" if contradictions else "undecided" if undecided else "proved"
+    text = (f"proved: exactly {found} equilibria {where}; consistency and stability of each "
+            "proved (ball LDL^T of the reduced Hessian)")  # fmt: skip
+    if status == "undecided":
+        text = (
+            f"not proved: {len(proof.undecided)} boxes undecided; {found} equilibria proved {where}"
+        )
+    elif status == "contradiction":
+        text = f"CONTRADICTION: the table and the proof differ ({found} equilibria proved {where})"
+    return status, f"{text}; {tail}"

@@ -57,6 +57,9 @@ class Settings:
     threads: int | None = None  # None: Bertini uses every core
     bertini: str | None = None  # path of a Bertini 1.x binary; None: the bundled bertini2
     extra_config: dict[str, str] = field(default_factory=dict)
+    # A Dask scheduler address: a generic set solved ab initio is split over its workers (where
+    # the paths are tracked, not what is found: not part of a result's key).
+    scheduler: str | None = None
 
     def __new__(cls, *args: object, **values: object) -> Settings:
         """Refuse an unknown setting with ParameterError (not a bare TypeError)."""
@@ -91,6 +94,11 @@ class Settings:
                 raise ParameterError(f"{name} = {value!r}: must be > 0")
         if self.engine == "homotopy":
             self._refuse_cli_only()
+        elif self.scheduler is not None:
+            raise ParameterError(
+                f"scheduler = {self.scheduler!r}: splitting paths over Dask workers needs "
+                "engine='homotopy' (the cli engine runs one Bertini process)"
+            )
 
     def _refuse_cli_only(self) -> None:
         for name, (default, what) in _CLI_ONLY.items():
@@ -139,12 +147,17 @@ class Settings:
         return replace(self, **values)
 
     def as_dict(self) -> dict:
-        """All settings, for run.json and cache keys."""
-        return asdict(self)
+        """All settings, for run.json and cache keys (`scheduler` only when set, so that the
+        sweep specs and keys written before it existed still match)."""
+        out = asdict(self)
+        if out["scheduler"] is None:
+            del out["scheduler"]
+        return out
 
     def result_key(self) -> dict:
-        """The settings a result depends on (not the time limit or the thread count)."""
-        return {k: v for k, v in self.as_dict().items() if k not in ("timeout", "threads")}
+        """The settings a result depends on (not the time limit, thread count or scheduler)."""
+        skip = ("timeout", "threads", "scheduler")
+        return {k: v for k, v in self.as_dict().items() if k not in skip}
 
 
 def _check_types(s: Settings) -> None:
@@ -158,6 +171,8 @@ def _check_types(s: Settings) -> None:
         value = getattr(s, name)
         if value is not None and (isinstance(value, bool) or not isinstance(value, int | float)):
             raise ParameterError(f"{name} = {value!r}: must be a number")
+    if s.scheduler is not None and (not isinstance(s.scheduler, str) or not s.scheduler.strip()):
+        raise ParameterError(f"scheduler = {s.scheduler!r}: expected an address, tcp://host:8786")
     if not isinstance(s.extra_config, dict):
         raise ParameterError(f"extra_config = {s.extra_config!r}: must be a dict")
 

@@ -179,8 +179,10 @@ def solve(
     solutions, classified real, physical, stable.
 
     Options are Settings fields (seed, engine, mptype, final_tol, timeout, threads, ...), each
-    honoured or refused with ParameterError. An identical earlier request is answered from the
-    content-hash cache (`cache=False` solves again). A solver failure raises SolverError; its
+    honoured or refused with ParameterError; `scheduler="tcp://host:8786"` splits the paths of
+    a generic set solved ab initio over that Dask cluster's workers (docs/frameworks.md). An
+    identical earlier request is answered from the content-hash cache (`cache=False` solves
+    again). A solver failure raises SolverError; its
     `folder` attribute holds what the solver left (input, output, failed attempts, run.json).
     """
     from ..io import cache as solve_cache
@@ -196,6 +198,10 @@ def solve(
             record["cache"] = {"hit": True, "key": key, "solved": record.get("solved"),
                                "seconds": time.perf_counter() - start}  # fmt: skip
             return Solutions(params, settings, record, hit)
+    if settings.scheduler is not None:  # an address nobody answers: refused before any work
+        from ..backends.dask_jobs import check_scheduler
+
+        check_scheduler(settings.scheduler)
     work = solve_cache.staging_folder() if cache else temp_folder("cotm-")
     point = _solve_in(work, params, settings, tol, label or "custom")
     record = solve_record(point, tol, label or "custom", key if cache else None)

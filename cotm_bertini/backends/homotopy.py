@@ -17,7 +17,7 @@ import json
 import sys
 import time
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -31,6 +31,7 @@ from ..settings import Settings
 from ..versions import bertini2_version
 from .endpoints import Endpoints
 from .render import render_parameter_homotopy, render_system
+from .start_system import gamma_homotopy_text, linear_product_start
 
 _SUCCESS = "Success"
 DOUBLE_FINAL_TOLERANCE = 1e-8
@@ -39,6 +40,10 @@ GENERIC_MAX_STEPS = 20000  # steps a path of a framework's generic solve may tak
 SECOND_START = 7919  # seed offset of the independent second generic set
 SECONDS_PER_PATH = 0.06  # an ab-initio path of the generic solve (case 3: 192 paths, ~12 s)
 ANNOUNCE_SECONDS = 2.0  # a generic solve expected to take longer is announced on stderr
+CHUNKS_PER_WORKER = 4  # a split generic solve sends this many chunks of paths per Dask worker
+INFINITE_CODES = ("GoingToInfinity", "SecurityMaxNormReached")
+# Every generic set cached before the route was recorded was solved by Bertini's own start.
+EARLIER_ROUTE = {"method": "bertini start system (ZeroDimSolver), one call"}
 
 
 def _bertini():
@@ -69,6 +74,8 @@ class GenericSet:
     singular_endpoints: int
     seconds: float
     bertini_version: str
+    route: dict = field(default_factory=lambda: dict(EARLIER_ROUTE))  # how it was solved
+    source: str = "solved"  # for this request: "solved" now, or read from "cache" or "memory"
 
     def to_json(self) -> dict:
         """JSON-able form (complex numbers as [re, im])."""
@@ -82,6 +89,7 @@ class GenericSet:
             "singular_endpoints": self.singular_endpoints,
             "seconds": self.seconds,
             "bertini_version": self.bertini_version,
+            "route": self.route,
         }
 
     @classmethod
@@ -98,6 +106,7 @@ class GenericSet:
             d["singular_endpoints"],
             d["seconds"],
             d["bertini_version"],
+            d.get("route", EARLIER_ROUTE),
         )
 
     def summary(self) -> dict:
@@ -111,6 +120,8 @@ class GenericSet:
             "tracked_points": len(self.points),
             "solve_seconds": self.seconds,
             "start_parameters": {k: [v.real, v.imag] for k, v in self.start.items()},
+            "route": self.route,
+            "source": self.source,
         }
 
 
@@ -153,39 +164,44 @@ def generic_set(
     use_cache: bool = True,
     centre: dict[str, float] | None = None,
     groups: list[list[str]] | None = None,
+    scheduler: str | None = None,
 ) -> GenericSet:
     """The generic solution set of `ps` for `seed`, from memory, the disk cache, or solved.
 
     Its start parameters are `centre` (default: the paper's case 3, normalised) plus a random
     complex perturbation of size START_SPREAD in every parameter. With variable `groups` the
-    ab-initio solve starts from a multihomogeneous start system (fewer paths)."""
+    ab-initio solve starts from a multihomogeneous start system (fewer paths). With a Dask
+    `scheduler` (an address) a solve is split: our own start system's paths in chunks on its
+    workers (`_split_solve`); the set is the same, and so is its key and cache entry."""
     if use_cache and (id(ps), seed) in _LOADED:  # ps objects live as long as the process
-        return _LOADED[id(ps), seed]
+        return replace(_LOADED[id(ps), seed], source="memory")
     centre = START_CENTRE if centre is None else centre
-    gs = _load_or_solve(ps, seed, use_cache, centre, groups)
+    gs = _load_or_solve(ps, seed, use_cache, centre, groups, scheduler)
     if use_cache:
         _LOADED[id(ps), seed] = gs
     return gs
 
 
 def _load_or_solve(
-    ps: ParametricSystem, seed: int, use_cache: bool, centre: dict, groups
+    ps: ParametricSystem, seed: int, use_cache: bool, centre: dict, groups, scheduler=None
 ) -> GenericSet:
     key = generic_key(ps, seed, centre, groups)
     path = cache_root() / f"generic-{key}.json"
     if use_cache and path.is_file():
         try:
-            return GenericSet.from_json(json.loads(path.read_text()))
+            return replace(GenericSet.from_json(json.loads(path.read_text())), source="cache")
         except (ValueError, KeyError):
             path.unlink(missing_ok=True)  # a damaged cache entry is recomputed, not trusted
-    _announce(ps, seed, path if use_cache else None, groups)
-    gs = _solve_generic(ps, seed, key, centre, groups)
+    _announce(ps, seed, path if use_cache else None, groups, scheduler)
+    gs = _solve_generic(ps, seed, key, centre, groups, scheduler)
     if use_cache:
         atomic_write_text(path, json.dumps(gs.to_json()))
     return gs
 
 
-def _announce(ps: ParametricSystem, seed: int, stored: Path | None, groups=None) -> None:
+def _announce(
+    ps: ParametricSystem, seed: int, stored: Path | None, groups=None, scheduler=None
+) -> None:
     """One line on stderr before a generic solve long enough to be noticed: what, how long."""
     paths = ps.instantiate([1.0 + 0.1j * k for k in range(len(ps.parameters))]).total_degree
     seconds = paths * SECONDS_PER_PATH
@@ -194,49 +210,165 @@ def _announce(ps: ParametricSystem, seed: int, stored: Path | None, groups=None)
     # A multihomogeneous start (groups) has fewer paths than the total degree: a bound.
     bound = "at most " if groups else ""
     where = f"once: kept in {stored} for every later solve" if stored else "not cached"
+    how = f", split over the Dask workers at {scheduler}" if scheduler else ""
     print(
         f"cotm-bertini: solving the generic solution set of these equations for seed {seed} "
-        f"({bound}{paths} paths, {'up to' if groups else 'roughly'} {seconds:.0f} s; {where})",
+        f"({bound}{paths} paths, {'up to' if groups else 'roughly'} {seconds:.0f} s{how}; "
+        f"{where})",
         file=sys.stderr,
         flush=True,
     )
 
 
 def _solve_generic(
-    ps: ParametricSystem, seed: int, key: str, centre: dict, groups=None
+    ps: ParametricSystem, seed: int, key: str, centre: dict, groups=None, scheduler=None
 ) -> GenericSet:
-    bertini = _bertini()
-    from bertini import nag_algorithm as na
-
     rng = np.random.default_rng(seed)
     start = {
         name: centre[name] + START_SPREAD * complex(*rng.normal(size=2)) / np.sqrt(2)
         for name in ps.parameters
     }
     system = ps.instantiate([start[n] for n in ps.parameters])
-    bertini.random.set_random_seed(seed)
     t0 = time.perf_counter()
+    if scheduler is None:
+        ends, route = _bertini_solve(system, seed, groups)
+    else:
+        ends, route = _split_solve(system, seed, groups, scheduler)
+    seconds = time.perf_counter() - t0
+    codes, finite_flags, singular, pts = ends
+    finite = [i for i, c in enumerate(codes) if finite_flags[i] and c == _SUCCESS]
+    regular = [i for i in finite if not singular[i]]
+    return GenericSet(
+        key,
+        seed,
+        start,
+        pts[regular] if regular else np.zeros((0, len(ps.variables)), dtype=complex),
+        len(codes),
+        len(finite),
+        len(finite) - len(regular),
+        seconds,
+        bertini2_version(),
+        route,
+    )
+
+
+def _bertini_solve(system, seed: int, groups) -> tuple[tuple, dict]:
+    """Every path of Bertini's own start system (multihomogeneous with `groups`, else total
+    degree) in one ZeroDimSolver call: (codes, finite, singular, points), the route record."""
+    bertini = _bertini()
+    from bertini import nag_algorithm as na
+
+    bertini.random.set_random_seed(seed)
     solver = na.ZeroDimSolver(bertini.parse.system(render_system(system, groups)))
     if groups:
         # A framework's start system can send a few paths crawling for ever; a path cut short
         # shows up as a count the second generic set (another seed) does not confirm.
         solver.set(max_num_steps=GENERIC_MAX_STEPS)
     solver.solve(show_progress=True)  # a bar on a terminal after 5 s; silent otherwise
-    seconds = time.perf_counter() - t0
     meta, pts = solver.solution_metadata(), solver.all_solutions()
-    finite = [i for i, m in enumerate(meta) if m.is_finite and _code(m) == _SUCCESS]
-    regular = [i for i in finite if not is_singular(meta[i])]
-    return GenericSet(
-        key,
-        seed,
-        start,
-        _points([pts[i] for i in regular]),
-        len(meta),
-        len(finite),
-        len(finite) - len(regular),
-        seconds,
-        bertini2_version(),
+    ends = (
+        [_code(m) for m in meta],
+        [bool(m.is_finite) for m in meta],
+        [is_singular(m) for m in meta],
+        _end_points(pts, len(system.variables)),
     )
+    start = "multihomogeneous" if groups else "total-degree"
+    return ends, {"method": f"bertini {start} start (ZeroDimSolver), one call"}
+
+
+def _split_solve(system, seed: int, groups, scheduler: str) -> tuple[tuple, dict]:
+    """Every path of our own linear-product start system (backends.start_system), tracked in
+    chunks on the Dask workers at `scheduler`: (codes, finite, singular, points), the route."""
+    from .dask_jobs import run_jobs
+
+    lp = linear_product_start(system, groups, seed)
+    gamma = np.exp(2j * np.pi * np.random.default_rng((seed, 1)).random())
+    texts = (gamma_homotopy_text(system, lp, gamma), render_system(system))
+    total = lp.count()
+    counts: dict[str, int] = {}
+
+    def jobs(workers: int) -> list[dict]:
+        counts["workers"] = workers
+        size = max(1, -(-total // (CHUNKS_PER_WORKER * workers)))
+        return [{"texts": texts, "points": c} for c in lp.chunks(size)]
+
+    done = dict(run_jobs(track_chunk, jobs, scheduler))
+    chunks = [done[k] for k in range(len(done))]
+    pts = np.vstack([c["points"] for c in chunks])
+    codes = [code for c in chunks for code in c["codes"]]
+    finite = [f for c in chunks for f in c["finite"]]
+    singular = [s for c in chunks for s in c["singular"]]
+    _mark_coincident(codes, finite, singular, pts)
+    failed = sum(c != _SUCCESS and c not in INFINITE_CODES for c in codes)
+    route = {
+        "method": f"own {'multihomogeneous' if groups else 'total-degree'} linear-product "
+        f"start, split in {len(chunks)} chunks on {scheduler}",
+        "scheduler": scheduler,
+        "workers": counts["workers"],
+        "chunks": len(chunks),
+        "paths_per_chunk": [len(c["codes"]) for c in chunks],
+        "chunk_seconds": [round(c["seconds"], 3) for c in chunks],
+        "failed_paths": failed,
+    }
+    return (codes, finite, singular, pts), route
+
+
+def _mark_coincident(codes: list, finite: list, singular: list, pts: np.ndarray) -> None:
+    """Nonsingular endpoints of different chunks at the same point: a multiple root (as
+    ZeroDimSolver marks multiplicity > 1 over all its paths), so singular."""
+    idx = [i for i, c in enumerate(codes) if c == _SUCCESS and finite[i] and not singular[i]]
+    if len(idx) < 2:
+        return
+    p = pts[idx]
+    scale = 1.0 + np.abs(p).max(axis=1)
+    for a in range(len(idx)):
+        d = np.abs(p[a + 1 :] - p[a]).max(axis=1) / np.maximum(scale[a + 1 :], scale[a])
+        for b in np.nonzero(d < 1e-7)[0]:
+            singular[idx[a]] = singular[idx[a + 1 + b]] = True
+
+
+def _end_points(pts, n: int) -> np.ndarray:
+    """Endpoints as an (m, n) array; a path to infinity may report other coordinates: NaN."""
+    out = np.full((len(pts), n), np.nan, dtype=complex)
+    for k, p in enumerate(pts):
+        if len(p) == n:
+            out[k] = [complex(z) for z in p]
+    return out
+
+
+def track_chunk(job: dict) -> dict:
+    """One chunk of a split generic solve (a Dask task: plain data in, plain data out): the
+    gamma-trick homotopy `job["texts"]` tracked from `job["points"]` in adaptive precision."""
+    bertini = _bertini()
+    from bertini import nag_algorithm as na
+
+    t0 = time.perf_counter()
+    hom, target = (bertini.parse.system(text) for text in job["texts"])
+    solver = na.HomotopySolver(hom, list(job["points"]), target, mptype="adaptive")
+    # One thread a chunk: the parallelism is the cluster's (as for a sweep's points).
+    solver.set(max_num_steps=GENERIC_MAX_STEPS, num_threads=1)
+    solver.solve(show_progress=False)
+    meta, pts = solver.solution_metadata(), solver.all_solutions()
+    return {
+        "codes": [_code(m) for m in meta],
+        "finite": [bool(m.is_finite) for m in meta],
+        "singular": [is_singular(m) for m in meta],
+        "points": _end_points(pts, len(job["points"][0])),
+        "seconds": time.perf_counter() - t0,
+    }
+
+
+def route_record(sets: list[GenericSet], scheduler: str | None) -> dict:
+    """How a solve's generic sets were obtained (solved now by which route, or loaded), and
+    whether a given Dask scheduler was used: only a set solved now needs it."""
+    out: dict = {"generic_sets": [{"seed": g.seed, "source": g.source, **g.route} for g in sets]}
+    if scheduler is not None:
+        used = any(g.source == "solved" for g in sets)
+        out["scheduler"] = scheduler
+        out["scheduler_used"] = used
+        if not used:
+            out["note"] = "scheduler not needed: every generic set was already solved"
+    return out
 
 
 def is_singular(m) -> bool:
@@ -359,7 +491,7 @@ def track(
         code = _code(m)
         if code == _SUCCESS and m.is_finite:
             rows.append(endpoint_record(i, m, p))
-        elif code in ("GoingToInfinity", "SecurityMaxNormReached") or not m.is_finite:
+        elif code in INFINITE_CODES or not m.is_finite:
             rep.infinite += 1
         else:
             rep.lost += 1
@@ -448,6 +580,6 @@ def ab_initio(
         if m.is_finite and code == _SUCCESS:
             if not is_singular(m):
                 rows.append(endpoint_record(i, m, p))
-        elif code not in ("GoingToInfinity", "SecurityMaxNormReached") and m.is_finite:
+        elif code not in INFINITE_CODES and m.is_finite:
             lost += 1
     return Endpoints.from_records(ps.variables, rows), lost

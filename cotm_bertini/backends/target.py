@@ -17,6 +17,7 @@ from .homotopy import (
     GenericSet,
     ab_initio,
     generic_set,
+    route_record,
     track,
     zero_length_roots,
 )
@@ -55,7 +56,7 @@ def solve_target(
     user's units; the spring lengths are scaled back.
     """
     deadline = None if settings.timeout is None else time.perf_counter() + settings.timeout
-    gs = generic_set(ps, settings.seed)
+    gs = generic_set(ps, settings.seed, scheduler=settings.scheduler)
     unit = params.normalized()
     result, note = None, ""
     if warm is not None:
@@ -83,6 +84,7 @@ def solve_target(
         generic_key=gs.key,
         generic_paths=gs.paths,
         generic_finite=gs.finite_endpoints,
+        generic_route=route_record([gs], settings.scheduler),
     )
     closed = zero_length_roots(params, ps.variables)
     return HomotopySolve(endpoints.concat(closed), info, gs, text, warm_next)
@@ -103,7 +105,10 @@ def from_generic(
     endpoints, rep = track(ps, gs, unit, settings, deadline)
     method = "parameter homotopy" + (" + adaptive retrack" if rep.retracked_adaptive else "")
     if rep.lost or rep.finite < len(gs.points):
-        gs2 = generic_set(ps, settings.seed + SECOND_START, centre=centre, groups=groups)
+        gs2 = generic_set(
+            ps, settings.seed + SECOND_START, centre=centre, groups=groups,
+            scheduler=settings.scheduler,
+        )  # fmt: skip
         endpoints2, rep2 = track(ps, gs2, unit, settings, deadline)
         if rep2.lost == 0 and not rep.lost and rep2.finite == rep.finite:
             method += "; finite count confirmed from a second start"
@@ -134,8 +139,10 @@ def solve_parameters(
     proves the set complete (`newton_continue`), else the generic set as without it."""
     deadline = None if settings.timeout is None else time.perf_counter() + settings.timeout
     centre = {n: centre[n] for n in ps.parameters}
-    gs = generic_set(ps, settings.seed, centre=centre, groups=groups)
-    gs2 = generic_set(ps, settings.seed + SECOND_START, centre=centre, groups=groups)
+    gs, gs2 = (
+        generic_set(ps, s, centre=centre, groups=groups, scheduler=settings.scheduler)
+        for s in (settings.seed, settings.seed + SECOND_START)
+    )
     result, note = (None, "") if warm is None else newton_continue(ps, gs, warm, target)
     if result is not None:
         endpoints, info, text = result
@@ -163,6 +170,7 @@ def solve_parameters(
         generic_finite=gs.finite_endpoints,
         generic_singular=gs.singular_endpoints,
         generic_counts=[len(gs.points), len(gs2.points)],
+        generic_route=route_record([gs, gs2], settings.scheduler),
     )
     return HomotopySolve(endpoints, info, gs, text, _next_start(gs, warm, target, endpoints, info))
 

@@ -44,6 +44,12 @@ def _solve_parser(sub) -> None:
     )
     s.add_argument("--quiet", action="store_true", help="print only where the files are")
     s.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="a Dask scheduler, tcp://host:8786: a generic set solved ab initio has its paths "
+        "split over the workers",
+    )
+    s.add_argument(
         "--certify",
         action="store_true",
         help="prove every solution and that no equilibrium is missing (docs/certify.md); "

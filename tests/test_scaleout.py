@@ -1,0 +1,244 @@
+"""Scale-out: a generic set's paths split over Dask workers (our own start system, in chunks).
+
+The evidence: our linear-product start system has exactly the multihomogeneous Bezout number of
+roots (counted here independently, as a coefficient of a polynomial product) and every one
+solves G; the split route finds the same generic set as Bertini's own ZeroDimSolver, which
+starts from a different start system; a solve with a scheduler gives the table of one without.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+import sympy
+from conftest import ROOT, run_cli
+
+import cotm_bertini as cb
+from cotm_bertini.backends import homotopy
+from cotm_bertini.backends.start_system import linear_product_start
+from cotm_bertini.model.framework.compiled import framework_system, variable_groups
+from cotm_bertini.model.polynomial import PolySystem
+from cotm_bertini.point import taut_sets
+
+ZEEMAN = ROOT / "examples" / "zeeman.toml"
+CONNECT = "DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT"  # Dask's own connect timeout
+# Two bodies in an open chain (a torus of poses), springs of zero free length: 8 paths.
+TINY_CHAIN = """
+name = "tiny_chain"
+dim = 2
+[parameters]
+k = 1.0
+[ground]
+o = [0.0, 0.0]
+a = [-0.6, 1.2]
+b = [1.5, -0.8]
+[bodies.link1]
+o = [0.0, 0.0]
+e = [1.0, 0.0]
+[bodies.link2]
+o = [0.0, 0.0]
+tip = [0.8, 0.0]
+[[pins]]
+a = "link1.o"
+b = "ground.o"
+[[pins]]
+a = "link2.o"
+b = "link1.e"
+[[springs]]
+name = "s1"
+a = "link1.e"
+b = "ground.a"
+k = "k"
+L0 = 0.0
+[[springs]]
+name = "s2"
+a = "link2.tip"
+b = "ground.b"
+k = "2*k"
+L0 = 0.0
+"""
+
+
+@pytest.fixture(scope="module")
+def scheduler():
+    """A two-process Dask cluster for this module (the workers import the package)."""
+    from distributed import LocalCluster
+
+    with LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as cluster:
+        yield cluster.scheduler_address
+
+
+def bezout(degrees: np.ndarray, sizes: list[int]) -> int:
+    """The multihomogeneous Bezout number, independently: the coefficient of prod z_g^|g| in
+    prod_i (sum_g d_ig z_g)."""
+    z = sympy.symbols(f"z0:{len(sizes)}")
+    terms = [sum(int(d) * zg for d, zg in zip(row, z, strict=True)) for row in degrees]
+    product = sympy.Mul(*terms)
+    poly = sympy.Poly(sympy.expand(product), *z)
+    return int(poly.coeff_monomial(sympy.Mul(*[zg**s for zg, s in zip(z, sizes, strict=True)])))
+
+
+def random_system(rng, sizes: list[int]) -> tuple[PolySystem, list[list[str]]]:
+    """A square system whose equation i has random degree d_ig in group g (one monomial
+    reaching each degree, plus a constant)."""
+    names = [f"x{g}_{k}" for g, s in enumerate(sizes) for k in range(s)]
+    groups, at = [], 0
+    for s in sizes:
+        groups.append(names[at : at + s])
+        at += s
+    exps, coefs = [], []
+    for _ in names:
+        deg = rng.integers(0, 3, size=len(sizes))
+        deg[rng.integers(len(sizes))] += 1  # every equation of degree >= 1 somewhere
+        rows = [np.zeros(len(names), dtype=int)]
+        for g, d in enumerate(deg):
+            if d:
+                row = np.zeros(len(names), dtype=int)
+                row[names.index(rng.choice(groups[g]))] = d
+                rows.append(row)
+        exps.append(np.array(rows))
+        coefs.append(rng.normal(size=len(rows)))
+    eqs = tuple(f"f{i}" for i in range(len(names)))
+    return PolySystem(tuple(names), eqs, tuple(exps), tuple(coefs)), groups
+
+
+def g_values(start, point: np.ndarray) -> np.ndarray:
+    """G at `point` from its rendered text, evaluated by sympy (not by start.evaluate)."""
+    subs = dict(zip(sympy.symbols(start.variables), point, strict=True))
+    return np.array(
+        [complex(sympy.sympify(t, locals={"I": sympy.I}).subs(subs)) for t in start.texts()]
+    )
+
+
+def test_start_system_roots_count_and_solve_g():
+    rng = np.random.default_rng(5)
+    for sizes in ([2, 1, 1], [1, 2, 1, 1], [3]):
+        system, groups = random_system(rng, sizes)
+        start = linear_product_start(system, groups, seed=3)
+        while not bezout(start.degrees, sizes):  # a group in too few equations: no roots
+            assert start.count() == 0 and not list(start.points())
+            system, groups = random_system(rng, sizes)
+            start = linear_product_start(system, groups, seed=3)
+        points = np.array(list(start.points()))
+        assert len(points) == start.count() == bezout(start.degrees, sizes)
+        for p in points[:: max(1, len(points) // 6)]:  # sympy is slow: a sample of the roots
+            assert np.abs(g_values(start, p)).max() < 1e-10
+        assert max(np.abs(start.evaluate(p)).max() for p in points) < 1e-10
+        gaps = [np.abs(points[k + 1 :] - points[k]).max(axis=1).min(initial=1) for k in
+                range(len(points))]  # fmt: skip
+        assert min(gaps) > 1e-6  # distinct roots: the count is a count of solutions
+
+
+def test_start_system_count_on_a_framework_equals_bertinis():
+    fw = cb.Framework.from_toml(ZEEMAN)
+    fs = framework_system(fw, taut_sets(fw)[0])
+    system = fs.ps.instantiate([1.0 + 0.2j * k for k in range(len(fs.ps.parameters))])
+    groups = variable_groups(fs)
+    start = linear_product_start(system, groups, seed=1)
+    assert start.count() == bezout(start.degrees, [len(g) for g in groups])
+    gs = homotopy.generic_set(fs.ps, 11, use_cache=False, centre=_centre(fw, fs), groups=groups)
+    assert start.count() == gs.paths  # Bertini's own multihomogeneous start: the same count
+
+
+def _centre(fw, fs) -> dict:
+    from cotm_bertini.model.framework.units import normalized_slots
+
+    centre = normalized_slots(fw.at_defaults())
+    return {n: centre[n] for n in fs.ps.parameters}
+
+
+def same_sets(a: np.ndarray, b: np.ndarray, tol: float = 1e-8) -> bool:
+    """Every row of a matches a distinct row of b to `tol` relative, and the sizes agree."""
+    if a.shape != b.shape:
+        return False
+    left = list(range(len(b)))
+    for p in a:
+        d = [np.abs(b[k] - p).max() / (1 + np.abs(p).max()) for k in left]
+        if not d or min(d) > tol:
+            return False
+        left.pop(int(np.argmin(d)))
+    return True
+
+
+def test_split_generic_set_equals_bertinis_on_a_two_body_chain(scheduler, tmp_path):
+    path = tmp_path / "tiny_chain.toml"
+    path.write_text(TINY_CHAIN)
+    fw = cb.Framework.from_toml(path)
+    fs = framework_system(fw, taut_sets(fw)[0])
+    kw = {"use_cache": False, "centre": _centre(fw, fs), "groups": variable_groups(fs)}
+    own = homotopy.generic_set(fs.ps, 3, scheduler=scheduler, **kw)
+    theirs = homotopy.generic_set(fs.ps, 3, **kw)
+    assert own.route["method"].startswith("own multihomogeneous")
+    assert theirs.route["method"].startswith("bertini multihomogeneous")
+    assert own.key == theirs.key and own.paths == theirs.paths
+    assert (own.finite_endpoints, own.singular_endpoints) == (
+        theirs.finite_endpoints,
+        theirs.singular_endpoints,
+    )
+    assert len(own.points) > 0 and same_sets(own.points, theirs.points)
+
+
+def _generic_files(folder: Path) -> dict[str, dict]:
+    return {p.name: json.loads(p.read_text()) for p in folder.glob("generic-*.json")}
+
+
+def test_solve_with_scheduler_equals_solve_without(scheduler, tmp_path, monkeypatch):
+    fw = cb.Framework.from_toml(ZEEMAN)
+    solved = {}
+    for name, options in (("split", {"scheduler": scheduler}), ("bertini", {})):
+        monkeypatch.setenv("COTM_CACHE", str(tmp_path / name))  # generic sets solved afresh
+        monkeypatch.setattr(homotopy, "_LOADED", {})
+        solved[name] = cb.solve(fw, cache=False, **options)
+    split, plain = solved["split"], solved["bertini"]
+    route = split.record["details"]["taut_sets"]["none"]["generic_route"]
+    assert route["scheduler_used"] and len(route["generic_sets"]) == 2
+    assert all(g["method"].startswith("own") and g["chunks"] >= 2 for g in route["generic_sets"])
+    assert split.record["settings"]["scheduler"] == scheduler
+    # Same generic sets (same keys, same files' names), found from two different start systems.
+    a, b = _generic_files(tmp_path / "split"), _generic_files(tmp_path / "bertini")
+    assert sorted(a) == sorted(b) and len(a) == 2
+    for name in a:
+        ga, gb = (homotopy.GenericSet.from_json(x[name]) for x in (a, b))
+        assert (ga.paths, ga.finite_endpoints, ga.singular_endpoints) == (
+            gb.paths,
+            gb.finite_endpoints,
+            gb.singular_endpoints,
+        )
+        assert same_sets(ga.points, gb.points)
+    for view in ("physical", "stable"):
+        x, y = getattr(split, view), getattr(plain, view)
+        assert len(x) == len(y) > 0
+        cols = [c for c in x.columns if "." in c]  # bodies' poses, nodes, lengths, tensions
+        assert len(cols) >= 4 and list(x["kind"]) == list(y["kind"])
+        assert np.allclose(x[cols].to_numpy(float), y[cols].to_numpy(float), atol=1e-9, rtol=0)
+    # Asked again with the sets in memory: nothing is solved, and the record says so.
+    again = cb.solve(fw, cache=False, scheduler=scheduler)
+    route = again.record["details"]["taut_sets"]["none"]["generic_route"]
+    assert not route["scheduler_used"] and "not needed" in route["note"]
+
+
+def test_old_generic_cache_without_route_loads():
+    gs = homotopy.GenericSet("k", 1, {"a": 1j}, np.ones((1, 2), complex), 4, 2, 1, 0.5, "v")
+    data = gs.to_json()
+    del data["route"]
+    old = homotopy.GenericSet.from_json(data)
+    assert old.route == homotopy.EARLIER_ROUTE and old.paths == 4
+
+
+def test_unreachable_scheduler_is_one_line_exit_2_nothing_written(tmp_path):
+    out = tmp_path / "runs"
+    for address in ("tcp://127.0.0.1:9", "nonsense"):
+        env = {"COTM_CACHE": str(tmp_path / "c"), CONNECT: "1s"}
+        res = run_cli("solve", "--framework", str(ZEEMAN), "--scheduler", address, "--no-cache",
+                      "--out", str(out), "--quiet", env=env)  # fmt: skip
+        assert res.returncode == 2, res.stderr
+        lines = res.stderr.strip().splitlines()
+        assert len(lines) == 1 and re.search(r"scheduler = '.*': no Dask scheduler", lines[0])
+        assert not out.exists()
+    assert not list((tmp_path / "c").glob("generic-*.json"))

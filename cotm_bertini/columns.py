@@ -100,6 +100,14 @@ REGIONS = {
     "stable": "the number of stable equilibria there",
 }
 
+FRAMEWORK_REGIONS = {
+    "<x>, <y>": "a grid point of a framework's map, in the units of its file (the two map "
+    "parameters, named as in the file): the window's ends and the evenly spaced values between, "
+    "each the double nearest its exact decimal value",
+    "physical": "the number of physical equilibria there (every taut set; the 2-D sweep's point)",
+    "stable": "the number of stable equilibria there",
+}
+
 DESIGN = {
     "gamma1_deg, gamma2_deg": "the pose asked for (deg), in [0, 360)",
     "L01, L02": "the free lengths (m) holding the pose in equilibrium (may be negative: then not "
@@ -132,6 +140,29 @@ BARRIERS = {
     "lowest": "this saddle is the lowest joining its two distinct minima: their barrier",
 }
 
+
+FRAMEWORK_BARRIERS = {
+    "saddle_id": "the solution_id (solutions.csv) of a physical critical point of index 1: a "
+    "saddle, or with one degree of freedom a maximum",
+    "min_a, min_b": "the solution_id of the minimum reached by gradient flow of V on the "
+    "constraint set from the saddle along +v and -v (v: the eigenvector of the reduced "
+    "Hessian's negative eigenvalue); empty if the flow did not converge or did not end at a "
+    "listed minimum (within 1e-7 in the sweeps' match coordinates)",
+    "barrier_a, barrier_b": "V(saddle) - V(end of that descent), in the file's units of k "
+    "times length^2: the energy to climb from that minimum over this saddle",
+    "BODY.angle_deg (BODY.qw ... BODY.qz), NODE.x ...": "the saddle's pose, named as in "
+    "solutions.csv",
+    "saddle_energy": "V at the saddle, as `energy` in solutions.csv",
+    "saddle_eigenvalues": "eigenvalues of the Lagrangian's Hessian on the constraints' tangent "
+    "space at the saddle, ascending, in the framework's normalised units (as hess_min_eig)",
+    "converged": "both descents reached a point where Newton's step on the constraint set is "
+    "below 1e-12 (normalised units) within max_steps steps",
+    "crosses_zero_length": "a descent passed a spring or cable shorter than 1e-3 of the "
+    "framework's length unit (its largest length): V has a cone point there if its L0 > 0",
+    "min_spring_length": "the shortest spring or cable along both descents (the file's length "
+    "unit)",
+    "lowest": "this saddle is the lowest joining its two distinct minima: their barrier",
+}
 
 COUNTS = {
     "paths_tracked": "paths the solver tracked (homotopy: the generic set's nonsingular "
@@ -251,13 +282,14 @@ def markdown(title: str, columns: dict[str, str], head: str = "column") -> str:
 def reference(*tables: str, title: str = "Columns of the CSV files in this folder") -> str:
     """The column reference of a run folder: 'solutions', 'counts', 'sweep', 'events',
     'barriers', 'folds', 'regions', 'design', 'framework', 'framework_counts',
-    'framework_sweep', 'framework_events'."""
+    'framework_sweep', 'framework_events', 'framework_regions', 'framework_barriers'."""
     known = {
         "solutions": ("solutions.csv", SOLUTIONS),
         "counts": ("counts (run.json `counts`, `res.counts`)", COUNTS, "count"),
         "sweep": ("sweep.csv", SWEEP),
         "events": ("events.csv", EVENTS),
         "barriers": ("barriers.csv", BARRIERS),
+        "framework_barriers": ("barriers.csv of a framework", FRAMEWORK_BARRIERS),
         "folds": ("folds.csv (`cb.fold_curves`)", FOLDS),
         "regions": ("regions.csv", REGIONS),
         "design": ("the design CSV (`cotm-bertini design --out`)", DESIGN),
@@ -265,6 +297,7 @@ def reference(*tables: str, title: str = "Columns of the CSV files in this folde
         "framework_counts": ("counts of a framework solve", FRAMEWORK_COUNTS, "count"),
         "framework_sweep": ("sweep.csv of a framework", FRAMEWORK_SWEEP),
         "framework_events": ("events.csv of a framework", FRAMEWORK_EVENTS),
+        "framework_regions": ("regions.csv of a framework's map", FRAMEWORK_REGIONS),
     }
     parts = [f"# {title}\n"]
     parts += [markdown(*known[t]) for t in tables]
@@ -286,5 +319,7 @@ def document() -> str:
         "framework_counts",
         "framework_sweep",
         "framework_events",
+        "framework_regions",
+        "framework_barriers",
         title="Columns of the CSV files",
     )

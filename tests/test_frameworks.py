@@ -217,10 +217,3 @@ def test_fourbar_against_a_scan_of_both_assembly_branches():
         _match(found["crank.angle_deg"], [np.degrees(t) for t, _ in crit], 1e-6)
         mins = [np.degrees(t) for t, kind in crit if kind == "min"]
         _match(found[found["stable"].astype(bool)]["crank.angle_deg"], mins, 1e-6)
-
-
-def test_paper_only_analyses_refuse_a_framework_in_one_line():
-    res = cb.solve(cb.Framework.from_toml(EXAMPLES / "zeeman.toml").replace(x=0.1, y=-0.25))
-    for analysis, name in ((cb.certify, "certify"), (cb.barriers, "barriers")):
-        with pytest.raises(ParameterError, match=f"{name}: covers the paper's mechanism only"):
-            analysis(res)

@@ -1,17 +1,24 @@
-"""Energy barriers between stable states: from each saddle, gradient flow down both sides of its
-unstable eigenvector to the minima it joins; the barrier of a pair of minima is the lowest
-saddle joining them.
+"""Energy barriers between stable states: from each saddle of index 1, gradient flow down both
+sides of its unstable eigenvector to the minima it joins; the barrier of a pair of minima is the
+lowest saddle joining them.
 
-The flow is followed by steepest-descent steps of at most MAX_STEP rad (each accepted only if V
-decreases), then Newton's method once the Hessian is positive definite and the Newton step is
-short, to the minimum to rounding. A path that passes a spring within ZERO_LENGTH L3 of zero
-length (where V has a cone point if that spring's L0 > 0: the flow is not smooth there) is
-flagged, never hidden.
+One driver for every model: a `Flow` gives the energy, its gradient in local coordinates, a
+step (`move`: a retraction, back onto the constraint set for a framework), Newton's step where
+the Hessian is positive definite, the shortest spring or cable, and which listed minimum a
+descent ended at. The paper's mechanism has `PaperFlow` (angles on the torus); a framework has
+analysis/framework_flow.FrameworkFlow (its reduced coordinates on the constraint set).
+
+The flow is followed by steepest-descent steps of at most MAX_STEP (rad, or framework length
+units), each accepted only if V decreases, then Newton's method once the Hessian is positive
+definite and the Newton step is short, to the minimum to rounding. A path that passes a spring
+or cable within ZERO_LENGTH (relative to the model's length) of zero length (where V has a cone
+point if its L0 > 0: the flow is not smooth there) is flagged, never hidden.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 import pandas as pd
@@ -24,53 +31,61 @@ from .design import generalised_forces
 KICK = 1e-3  # rad: the first step off the saddle, along the unstable eigenvector
 MAX_STEP = 0.02  # rad
 MAX_STEPS = 20000
-ZERO_LENGTH = 1e-3  # relative to L3
+ZERO_LENGTH = 1e-3  # relative to L3 (a framework: its length unit)
 MATCH_DEG = 1e-5  # a descent end within this (deg, on the torus) of a minimum is that minimum
+NEWTON_RANGE = 0.1  # Newton's step is taken once it is shorter than this
+
+
+class Flow(Protocol):
+    """What the driver needs of a model (states are numpy vectors; steps in local coordinates)."""
+
+    newton_tol: float  # converged once Newton's step is shorter than this
+    zero_length: float  # a spring shorter than this is flagged (user units)
+    pose_names: list[str]  # the barriers.csv columns that place the saddle
+
+    def saddles(self, solutions: pd.DataFrame) -> pd.DataFrame: ...
+    def saddle(self, row) -> tuple[np.ndarray, np.ndarray, np.ndarray]: ...
+    def pose(self, row) -> dict: ...
+    def energy(self, x: np.ndarray) -> float: ...
+    def gradient(self, x: np.ndarray) -> np.ndarray: ...
+    def newton(self, x: np.ndarray, grad: np.ndarray) -> np.ndarray | None: ...
+    def move(self, x: np.ndarray, step: np.ndarray) -> np.ndarray: ...
+    def shortest(self, x: np.ndarray) -> float: ...
+    def match(self, end: np.ndarray) -> int | None: ...
+    def record(self, path: np.ndarray) -> object: ...
 
 
 @dataclass(frozen=True)
 class Descent:
-    """One gradient-flow path from a saddle: angles (rad, unwrapped), its end, what it met."""
+    """One gradient-flow path from a saddle: the states, whether it converged, what it met."""
 
-    path: np.ndarray  # (n, 2)
+    path: np.ndarray  # (n, state size)
     converged: bool
-    min_spring_length: float  # m, along the path
+    min_spring_length: float  # user units, along the path
 
 
-def _shortest_spring(params: Params, x: np.ndarray) -> float:
-    return float(generalised_forces(params, x[0], x[1])[1].min())
-
-
-def _newton_step(params: Params, x: np.ndarray, grad: np.ndarray) -> np.ndarray | None:
-    """The Newton step where the Hessian is positive definite, else None."""
-    hess = energy_hessian(params, x[0], x[1])[0]
-    if np.linalg.eigvalsh(hess).min() <= 0:
-        return None
-    return -np.linalg.solve(hess, grad)
-
-
-def descend(params: Params, start: np.ndarray) -> Descent:
-    """Gradient flow of V from `start` (rad) to a minimum."""
+def descend(flow: Flow, start: np.ndarray, max_steps: int = MAX_STEPS) -> Descent:
+    """Gradient flow of V from `start` to a minimum (at most `max_steps` steps)."""
     x = np.array(start, dtype=float)
-    path, shortest = [x.copy()], _shortest_spring(params, x)
-    v, step = float(energy(params, *x)), MAX_STEP
-    for _ in range(MAX_STEPS):
-        grad = energy_gradient(params, x[0], x[1])[0]
-        newton = _newton_step(params, x, grad)
-        if newton is not None and np.abs(newton).max() < 0.1:
-            x = x + newton
-            v = float(energy(params, *x))
+    path, shortest = [x.copy()], flow.shortest(x)
+    v, step = flow.energy(x), MAX_STEP
+    for _ in range(max_steps):
+        grad = flow.gradient(x)
+        newton = flow.newton(x, grad)
+        if newton is not None and np.abs(newton).max() < NEWTON_RANGE:
+            x = flow.move(x, newton)
+            v = flow.energy(x)
             path.append(x.copy())
-            shortest = min(shortest, _shortest_spring(params, x))
-            if np.abs(newton).max() < 1e-13:
+            shortest = min(shortest, flow.shortest(x))
+            if np.abs(newton).max() < flow.newton_tol:
                 return Descent(np.array(path), True, shortest)
             continue
-        norm = float(np.hypot(*grad))
+        norm = float(np.hypot.reduce(np.abs(grad)))
         if norm == 0:
             break
         while step > 1e-14:
-            trial = x - step * grad / norm
-            vt = float(energy(params, *trial))
+            trial = flow.move(x, -(step * grad / norm))
+            vt = flow.energy(trial)
             if vt < v:
                 break
             step /= 2
@@ -79,57 +94,47 @@ def descend(params: Params, start: np.ndarray) -> Descent:
         x, v = trial, vt
         step = min(MAX_STEP, 2 * step)
         path.append(x.copy())
-        shortest = min(shortest, _shortest_spring(params, x))
+        shortest = min(shortest, flow.shortest(x))
     return Descent(np.array(path), False, shortest)
 
 
-def _match(end: np.ndarray, minima: pd.DataFrame) -> int | None:
-    """The solution_id of the minimum the descent ended at (None: not a listed minimum)."""
-    if minima.empty:
-        return None
-    angles = minima[["gamma1_deg", "gamma2_deg"]].to_numpy(float)
-    dist = deg_distance(np.degrees(end), angles)
-    k = int(np.argmin(dist))
-    return int(minima.solution_id.iloc[k]) if dist[k] < MATCH_DEG else None
-
-
-def saddle_connections(params: Params, solutions: pd.DataFrame) -> tuple[pd.DataFrame, dict]:
-    """One row per physical saddle: the minima its two descents reach, the barriers from each
-    side, whether a path passes a spring of (near) zero length, and `lowest` (the lowest saddle
-    joining that pair of distinct minima). Also {saddle_id: (path_a, path_b)} in degrees."""
-    phys = solutions[solutions.physical.astype(bool)]
-    minima = phys[phys.kind == "min"]
+def saddle_connections(flow: Flow, solutions: pd.DataFrame,
+                       max_steps: int = MAX_STEPS) -> tuple[pd.DataFrame, dict]:  # fmt: skip
+    """One row per physical saddle of index 1: the minima its two descents reach, the barriers
+    from each side, whether a path passes a spring of (near) zero length, and `lowest` (the
+    lowest saddle joining that pair of distinct minima). Also {saddle_id: (path_a, path_b)} as
+    `flow.record` gives them."""
     rows, paths = [], {}
-    for _, s in phys[phys.kind == "saddle"].iterrows():
-        x0 = np.radians([s.gamma1_deg, s.gamma2_deg])
-        eigval, eigvec = np.linalg.eigh(energy_hessian(params, x0[0], x0[1])[0])
-        v_s = float(energy(params, *x0))
-        ends = [descend(params, x0 + sign * KICK * eigvec[:, 0]) for sign in (1, -1)]
-        ids = [_match(e.path[-1], minima) if e.converged else None for e in ends]
-        energies = [float(energy(params, *e.path[-1])) for e in ends]
+    for _, s in flow.saddles(solutions).iterrows():
+        x0, eigval, unstable = flow.saddle(s)
+        v_s = flow.energy(x0)
+        starts = [flow.move(x0, sign * KICK * unstable) for sign in (1, -1)]
+        ends = [descend(flow, start, max_steps) for start in starts]
+        ids = [flow.match(e.path[-1]) if e.converged else None for e in ends]
+        energies = [flow.energy(e.path[-1]) for e in ends]
+        shortest = min(e.min_spring_length for e in ends)
         rows.append(
             {
                 "saddle_id": int(s.solution_id),
                 "min_a": ids[0], "min_b": ids[1],
                 "barrier_a": v_s - energies[0], "barrier_b": v_s - energies[1],
-                "saddle_gamma1_deg": float(s.gamma1_deg),
-                "saddle_gamma2_deg": float(s.gamma2_deg),
+                **flow.pose(s),
                 "saddle_energy": v_s,
-                "saddle_eigenvalues": f"{eigval[0]:.6g} {eigval[1]:.6g}",
+                "saddle_eigenvalues": " ".join(f"{e:.6g}" for e in eigval),
                 "converged": all(e.converged for e in ends),
-                "crosses_zero_length": min(e.min_spring_length for e in ends)
-                < ZERO_LENGTH * params.L3,
-                "min_spring_length": min(e.min_spring_length for e in ends),
+                "crosses_zero_length": shortest < flow.zero_length,
+                "min_spring_length": shortest,
             }
         )  # fmt: skip
-        paths[int(s.solution_id)] = tuple(np.degrees(e.path) for e in ends)
-    return _mark_lowest(pd.DataFrame(rows, columns=BARRIER_COLUMNS)), paths
+        paths[int(s.solution_id)] = tuple(flow.record(e.path) for e in ends)
+    columns = HEAD_COLUMNS + flow.pose_names + TAIL_COLUMNS
+    return _mark_lowest(pd.DataFrame(rows, columns=columns)), paths
 
 
-BARRIER_COLUMNS = [
-    "saddle_id", "min_a", "min_b", "barrier_a", "barrier_b", "saddle_gamma1_deg",
-    "saddle_gamma2_deg", "saddle_energy", "saddle_eigenvalues", "converged",
-    "crosses_zero_length", "min_spring_length",
+HEAD_COLUMNS = ["saddle_id", "min_a", "min_b", "barrier_a", "barrier_b"]
+TAIL_COLUMNS = [
+    "saddle_energy", "saddle_eigenvalues", "converged", "crosses_zero_length",
+    "min_spring_length",
 ]  # fmt: skip
 
 
@@ -144,3 +149,68 @@ def _mark_lowest(table: pd.DataFrame) -> pd.DataFrame:
         idx = [i for i, p in enumerate(pair) if p == key]
         lowest[min(idx, key=lambda i: table.saddle_energy.iloc[i])] = True
     return table.assign(lowest=lowest)
+
+
+class PaperFlow:
+    """The paper's mechanism: states are (gamma1, gamma2) in rad, unwrapped on the torus."""
+
+    newton_tol = 1e-13
+    pose_names = ["saddle_gamma1_deg", "saddle_gamma2_deg"]
+
+    def __init__(self, params: Params, solutions: pd.DataFrame):
+        self.params = params
+        self.zero_length = ZERO_LENGTH * params.L3
+        phys = solutions[solutions.physical.astype(bool)]
+        self.minima = phys[phys.kind == "min"]
+
+    def saddles(self, solutions: pd.DataFrame) -> pd.DataFrame:
+        """The physical saddles (on the torus every saddle has index 1)."""
+        phys = solutions[solutions.physical.astype(bool)]
+        return phys[phys.kind == "saddle"]
+
+    def saddle(self, row) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The saddle's angles (rad), Hessian eigenvalues and unstable eigenvector."""
+        x0 = np.radians([row.gamma1_deg, row.gamma2_deg])
+        eigval, eigvec = np.linalg.eigh(energy_hessian(self.params, x0[0], x0[1])[0])
+        return x0, eigval, eigvec[:, 0]
+
+    def pose(self, row) -> dict:
+        """The saddle's barriers.csv pose columns."""
+        return {"saddle_gamma1_deg": float(row.gamma1_deg),
+                "saddle_gamma2_deg": float(row.gamma2_deg)}  # fmt: skip
+
+    def energy(self, x: np.ndarray) -> float:
+        """V (J)."""
+        return float(energy(self.params, *x))
+
+    def gradient(self, x: np.ndarray) -> np.ndarray:
+        """dV/dgamma (J/rad)."""
+        return energy_gradient(self.params, x[0], x[1])[0]
+
+    def newton(self, x: np.ndarray, grad: np.ndarray) -> np.ndarray | None:
+        """The Newton step where the Hessian is positive definite, else None."""
+        hess = energy_hessian(self.params, x[0], x[1])[0]
+        if np.linalg.eigvalsh(hess).min() <= 0:
+            return None
+        return -np.linalg.solve(hess, grad)
+
+    def move(self, x: np.ndarray, step: np.ndarray) -> np.ndarray:
+        """Angles are their own coordinates."""
+        return x + step
+
+    def shortest(self, x: np.ndarray) -> float:
+        """The shorter spring (m)."""
+        return float(generalised_forces(self.params, x[0], x[1])[1].min())
+
+    def match(self, end: np.ndarray) -> int | None:
+        """The solution_id of the minimum the descent ended at (None: not a listed minimum)."""
+        if self.minima.empty:
+            return None
+        angles = self.minima[["gamma1_deg", "gamma2_deg"]].to_numpy(float)
+        dist = deg_distance(np.degrees(end), angles)
+        k = int(np.argmin(dist))
+        return int(self.minima.solution_id.iloc[k]) if dist[k] < MATCH_DEG else None
+
+    def record(self, path: np.ndarray) -> np.ndarray:
+        """A path in degrees (unwrapped)."""
+        return np.degrees(path)

@@ -34,7 +34,7 @@ def framework_columns(
     var = {name: X[:, k] for k, name in enumerate(fs.ps.variables)}
     pos = positions(fs, x, slot_vector(slots_n), fw.dim, unit[0])
     cols: dict[str, np.ndarray] = {}
-    cols.update(_pose_columns(fw, fs, var, pos))
+    cols.update(pose_columns(fw, fs, var, pos))
     links, reason, borderline = _link_columns(fw, fs, var, pos, unit, tol)
     cols.update(links)
     cols["energy"] = _energy(fw, pos, links)
@@ -81,7 +81,7 @@ def positions(fs: FrameworkSystem, x: np.ndarray, P: np.ndarray, dim: int, lengt
     return {p: np.stack(flat[k * dim : (k + 1) * dim], axis=1) for k, p in enumerate(fs.points)}
 
 
-def _pose_columns(fw: Framework, fs: FrameworkSystem, var: dict, pos: dict) -> dict:
+def pose_columns(fw: Framework, fs: FrameworkSystem, var: dict, pos: dict) -> dict:
     cols = {}
     for body, _ in fw.bodies:
         for a in range(fw.dim):
@@ -160,18 +160,14 @@ def _energy(fw: Framework, pos: dict, links: dict) -> np.ndarray:
 
 def _stability(fs: FrameworkSystem, x: np.ndarray, slots_n: dict, mask: np.ndarray, tol):
     """kind, index and smallest eigenvalue of the reduced Hessian (normalised units), per row."""
-    n, m = len(x), fs.local_size
+    n = len(x)
     kind = np.full(n, "", dtype=object)
     index = np.full(n, -1, dtype=int)
     eig_min = np.full(n, np.nan)
     if not mask.any():
         return kind, index, eig_min
-    X = x[mask].real
     P = np.array([slots_n[s] for s in slots_n])
-    H = _stack(fs.numeric.hessian(X, P), len(X)).reshape(len(X), m, m)
-    G = np.zeros((len(X), 0, m))
-    if fs.constraints:
-        G = _stack(fs.numeric.constraint_jacobian(X, P), len(X)).reshape(len(X), -1, m)
+    H, G = local_hessian(fs, x[mask].real, P)
     for k, row in enumerate(np.flatnonzero(mask)):
         eig = _reduced_eigenvalues(H[k], G[k])
         limit = tol.hessian * max(1.0, float(np.abs(H[k]).max()))
@@ -188,16 +184,48 @@ def _stability(fs: FrameworkSystem, x: np.ndarray, slots_n: dict, mask: np.ndarr
     return kind, index, eig_min
 
 
+def local_hessian(fs: FrameworkSystem, X: np.ndarray, P: np.ndarray) -> tuple:
+    """The Lagrangian's Hessian (n, m, m) and the constraint Jacobian (n, c, m) in local
+    coordinates at real solutions X (n, variables) of the structure, slots P (normalised)."""
+    n, m = len(X), fs.local_size
+    H = _stack(fs.numeric.hessian(X, P), n).reshape(n, m, m)
+    G = np.zeros((n, 0, m))
+    if fs.constraints:
+        G = _stack(fs.numeric.constraint_jacobian(X, P), n).reshape(n, -1, m)
+    return H, G
+
+
 def _stack(values: list, n: int) -> np.ndarray:
-    return np.stack([np.broadcast_to(np.asarray(v, dtype=float), (n,)) for v in values], axis=1)
+    out = np.empty((n, len(values)))
+    for k, v in enumerate(values):
+        out[:, k] = v  # a constant entry of the generated code is a float: broadcast
+    return out
+
+
+def tangent_basis(G: np.ndarray, m: int) -> np.ndarray:
+    """An orthonormal basis (m, m - rank) of the null space of the constraint Jacobian G (c, m):
+    the directions the constraints allow."""
+    if not len(G):
+        return np.eye(m)
+    _, s, vt = np.linalg.svd(G)
+    rank = int((s > 1e-10 * max(1.0, s.max(initial=0.0))).sum())
+    return vt[rank:].T
+
+
+def reduced_eigh(H: np.ndarray, G: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Eigenvalues (ascending) of H on the null space of G, and their eigenvectors in local
+    coordinates (columns)."""
+    N = tangent_basis(G, len(H))
+    eig, vec = np.linalg.eigh(_reduce(H, G, N))
+    return eig, N @ vec
+
+
+def _reduce(H: np.ndarray, G: np.ndarray, N: np.ndarray) -> np.ndarray:
+    H = (H + H.T) / 2
+    return N.T @ H @ N if len(G) else H
 
 
 def _reduced_eigenvalues(H: np.ndarray, G: np.ndarray) -> np.ndarray:
     """Eigenvalues of H on the null space of the constraint Jacobian G."""
-    H = (H + H.T) / 2
-    if len(G):
-        _, s, vt = np.linalg.svd(G)
-        rank = int((s > 1e-10 * max(1.0, s.max(initial=0.0))).sum())
-        N = vt[rank:].T
-        H = N.T @ H @ N
-    return np.linalg.eigvalsh(H) if H.size else np.zeros(0)
+    R = _reduce(H, G, tangent_basis(G, len(H)))
+    return np.linalg.eigvalsh(R) if R.size else np.zeros(0)

@@ -1,4 +1,5 @@
-"""Energy barriers between the stable states of a solve (cb.barriers)."""
+"""Energy barriers between the stable states of a solve (cb.barriers): the paper's mechanism or
+any framework, through one driver (analysis/barriers.py)."""
 
 from __future__ import annotations
 
@@ -8,12 +9,18 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
+from ..analysis.barriers import MAX_STEPS, PaperFlow, saddle_connections
 from ..columns import reference
+from ..errors import ParameterError
 from ..fs import atomic_write_text, new_folder, write_csv
+from ..model.framework.spec import Framework
 from ..params import Params
-from .solutions import Solutions, paper_only
+from .solutions import Solutions
+
+MATCH_POSE = 1e-7  # a framework's descent end this close (match coordinates) is that minimum
 
 BARRIERS_CSV = "barriers.csv"
 
@@ -21,14 +28,17 @@ BARRIERS_CSV = "barriers.csv"
 @dataclass(frozen=True)
 class Barriers:
     """Every saddle's two descents and barriers (`table`, see docs/columns.md), `pairs` (the
-    lowest saddle of each pair of minima: their barrier), and the paths (deg) by saddle_id.
-    Both tables are indexed by saddle_id, as the solutions table is by solution_id."""
+    lowest saddle of each pair of minima: their barrier), and the paths by saddle_id (the
+    paper's mechanism: (n, 2) arrays of angles in deg; a framework: DataFrames with `arc`,
+    `energy`, the pose columns and link lengths of solutions.csv). Both tables are indexed by
+    saddle_id, as the solutions table is by solution_id."""
 
-    params: Params
+    params: Params | Framework
     solutions: pd.DataFrame
     table: pd.DataFrame
     paths: dict = field(repr=False)
     seconds: float = 0.0
+    max_steps: int = MAX_STEPS
 
     @property
     def pairs(self) -> pd.DataFrame:
@@ -41,26 +51,37 @@ class Barriers:
         a spring of (near) zero length."""
         out = []
         for _, r in self.table.iterrows():
-            if not r.converged or pd.isna(r.min_a) or pd.isna(r.min_b):
+            if not r.converged:
+                out.append(f"saddle {r.saddle_id}: a descent did not converge in "
+                           f"{self.max_steps} steps")  # fmt: skip
+            elif pd.isna(r.min_a) or pd.isna(r.min_b):
                 out.append(f"saddle {r.saddle_id}: a descent did not end at a listed minimum")
             if r.crosses_zero_length:
                 out.append(f"saddle {r.saddle_id}: a descent passes a spring of zero length")
         return out
 
     def plot(self, path: str | Path) -> list[Path]:
-        """The energy map with the descent paths (PNG and SVG, or the one suffix given)."""
+        """The paper's mechanism: the energy map with the descent paths; a framework: V along
+        each descent (PNG and SVG, or the one suffix given)."""
         from ..plot.common import save
-        from ..plot.energy_map import barrier_figure
 
-        return save(barrier_figure(self.params, self.solutions, self.paths), path)
+        if isinstance(self.params, Params):
+            from ..plot.energy_map import barrier_figure
+
+            return save(barrier_figure(self.params, self.solutions, self.paths), path)
+        from ..plot.barrier_profile import barrier_profile_figure
+
+        return save(barrier_profile_figure(self.params, self.table, self.paths), path)
 
     def save(self, folder: str | Path, plots: bool = True) -> Path:
         """barriers.csv, columns.md, barriers.json [, barriers.png/svg] in a new folder, built
         under a hidden name and renamed when complete."""
         with new_folder(folder) as work:
             write_csv(work / BARRIERS_CSV, self.table)
-            atomic_write_text(work / "columns.md", reference("barriers"))
-            record = {"params": self.params.as_dict(), "seconds": self.seconds,
+            table = "barriers" if isinstance(self.params, Params) else "framework_barriers"
+            atomic_write_text(work / "columns.md", reference(table))
+            record = {"params": self.params.as_dict(), **self.params.record_fields(),
+                      "max_steps": self.max_steps, "seconds": self.seconds,
                       "warnings": self.warnings, "command": sys.argv[:]}  # fmt: skip
             atomic_write_text(work / "barriers.json", json.dumps(record, indent=2))
             if plots:
@@ -68,12 +89,45 @@ class Barriers:
         return Path(folder)
 
 
-def barriers(res: Solutions) -> Barriers:
-    """For a solve: every physical saddle's descents to the minima, and the barriers."""
-    from ..analysis.barriers import saddle_connections
-
-    paper_only(res, "barriers")
+def barriers(res: Solutions, max_steps: int = MAX_STEPS) -> Barriers:
+    """For a solve (the paper's mechanism or a framework): every physical saddle's descents to
+    the minima, and the barriers; each descent takes at most `max_steps` steps."""
+    if isinstance(max_steps, bool) or not isinstance(max_steps, int | np.integer) or max_steps < 1:
+        raise ParameterError(f"max_steps = {max_steps!r}: expected a whole number >= 1")
     t0 = time.perf_counter()
-    table, paths = saddle_connections(res.params, res.table)
+    table, paths = saddle_connections(_flow(res), res.table, int(max_steps))
     table = table.set_axis(pd.Index(table["saddle_id"].to_numpy(dtype=int)), axis=0)
-    return Barriers(res.params, res.table, table, paths, time.perf_counter() - t0)
+    return Barriers(res.params, res.table, table, paths, time.perf_counter() - t0,
+                    int(max_steps))  # fmt: skip
+
+
+def _flow(res: Solutions):
+    """The driver's model of the solve's mechanism."""
+    if isinstance(res.params, Params):
+        return PaperFlow(res.params, res.table)
+    from ..analysis.framework_flow import FrameworkFlow
+    from ..continuation.framework import pose_names
+
+    fw = res.params
+    return FrameworkFlow(fw, pose_names(fw), _matcher(fw, res.table))
+
+
+def _matcher(fw: Framework, table: pd.DataFrame):
+    """Which physical minimum of `table` a descent's end row is: the nearest in the sweeps'
+    match coordinates (cos, sin of angles, quaternions, positions and link lengths over the
+    length unit), if within MATCH_POSE."""
+    from ..continuation.framework import match_coordinates
+
+    phys = table[table.physical.astype(bool)]
+    minima = phys[phys.kind == "min"]
+    ref = match_coordinates(fw, minima.assign(point=0)).real if len(minima) else None
+
+    def match(rows: pd.DataFrame) -> int | None:
+        if ref is None:
+            return None
+        end = rows.assign(point=0, is_real=True, max_imag=0.0)
+        dist = np.abs(ref - match_coordinates(fw, end).real[0]).max(axis=1)
+        k = int(np.argmin(dist))
+        return int(minima.solution_id.iloc[k]) if dist[k] < MATCH_POSE else None
+
+    return match

@@ -130,10 +130,9 @@ def _pseudo_energy(fw: Framework, lay: Layout, pos: _Positions, taut) -> tuple:
     return E, variables, kinds, equations, about
 
 
-def derive(fw: Framework, taut: tuple[str, ...]) -> Derived:
-    """The equilibrium system of `fw` with the cables in `taut` taut and the others slack."""
-    from ..symbolic import numpy_function, parametric_from_sympy
-
+def equilibrium_equations(fw: Framework, taut: tuple[str, ...]) -> tuple:
+    """(variables, their unit kinds, equations, descriptions) of the equilibrium system: sympy
+    expressions in the variables and the non-constant slots (normalised units)."""
     lay = layout(fw)
     const = {sp.Symbol(n): sp.Float(v, 17) for n, v in constants(fw).items()}
     rot_syms = {b: [sp.Symbol(n) for n in rotation_names(fw.dim, b)] for b in lay.rotations}
@@ -142,8 +141,19 @@ def derive(fw: Framework, taut: tuple[str, ...]) -> Derived:
     E, extra, extra_kinds, laws, law_about = _pseudo_energy(fw, lay, pos, taut)
     balance, about = _balance(E, fw.dim, lay, rot_syms, config)
     equations = [sp.expand(f.xreplace(const)) for f in balance + laws]
-    descriptions = about + law_about
-    variables = config + extra
+    return config + extra, kinds + extra_kinds, equations, about + law_about
+
+
+def derive(fw: Framework, taut: tuple[str, ...]) -> Derived:
+    """The equilibrium system of `fw` with the cables in `taut` taut and the others slack."""
+    from ..symbolic import numpy_function, parametric_from_sympy
+
+    lay = layout(fw)
+    const = {sp.Symbol(n): sp.Float(v, 17) for n, v in constants(fw).items()}
+    rot_syms = {b: [sp.Symbol(n) for n in rotation_names(fw.dim, b)] for b in lay.rotations}
+    pos = _Positions(fw, lay, {b: _rotation(fw.dim, q) for b, q in rot_syms.items()})
+    config, _ = _unknowns(fw, lay)
+    variables, kinds, equations, descriptions = equilibrium_equations(fw, taut)
     free = [descriptions[i] for i, f in enumerate(equations) if f == 0]
     if not _active(fw, taut) and not fw.loads:
         free.insert(0, "any motion (no spring, taut cable or load acts)")
@@ -158,14 +168,17 @@ def derive(fw: Framework, taut: tuple[str, ...]) -> Derived:
     coords = [c for p in points[: -len(lay.rotations) or None] for c in pos.of(p)]
     coords += [c for b in lay.rotations for c in pos.translation(b)]
     args = {"X": [sp.Symbol(v) for v in variables], "P": [sp.Symbol(n) for n in slots]}
+    # constraint_values: the bars' and closing pins' residuals, which a gradient flow on the
+    # constraint set (analysis/framework_flow.py) projects back to zero.
     functions = {"positions": coords, "hessian": hess, "constraint_jacobian": cjac,
-                 "first_order": firsts}  # fmt: skip
+                 "first_order": firsts,
+                 "constraint_values": [g for g, *_ in _constraints(fw, lay, pos)]}  # fmt: skip
     source = "from numpy import sqrt, sin, cos\n\n" + "\n".join(
         numpy_function(name, args, [e.xreplace(const) for e in exprs] or [sp.S(0)])
         for name, exprs in functions.items()
     )
     cones = _cone_systems(fw, lay, pos, taut, slots, const)
-    return Derived(ps.to_json(), kinds + extra_kinds, descriptions, free, points, local,
+    return Derived(ps.to_json(), kinds, descriptions, free, points, local,
                    len(cjac) // max(local, 1), source, [x.name for x in _active(fw, taut)],
                    cones)  # fmt: skip
 
@@ -238,7 +251,49 @@ def _balance(E, dim: int, lay: Layout, rot_syms: dict, config: list[str]) -> tup
 
 def _second_order(fw: Framework, lay: Layout, rot_syms: dict, taut: tuple[str, ...],
                   config: list[str]) -> tuple[int, list, list]:  # fmt: skip
-    """The Lagrangian's Hessian and the constraints' Jacobian in local coordinates.
+    """The Lagrangian's Hessian and the constraints' Jacobian in local coordinates."""
+    local, at, pos = _local_frame(fw, lay, rot_syms, config)
+    V = sp.Integer(0)
+    zfl = set(fw.zero_free_length())
+    for x in _active(fw, taut):
+        r = pos.of(x.a) - pos.of(x.b)
+        k, L0 = sp.Symbol(f"k_{x.name}"), sp.Symbol(f"L0_{x.name}")
+        V += k / 2 * (r.dot(r) if x.name in zfl else (sp.sqrt(r.dot(r)) - L0) ** 2)
+    V -= _load_energy(fw, pos)
+    cons = _constraints(fw, lay, pos)
+    L = V + sum(sp.Symbol(name) * g for g, name, _, _ in cons)
+    hess = [sp.diff(L, a, b).subs(at) for a in local for b in local]
+    cjac = [sp.diff(g, a).subs(at) for g, *_ in cons for a in local]
+    # First order, for cone points: each active link's vector r and dr/dlocal, and the loads'
+    # energy gradient.
+    firsts = []
+    for x in _active(fw, taut):
+        r = pos.of(x.a) - pos.of(x.b)
+        firsts += [ri.subs(at) for ri in r] + [sp.diff(ri, a).subs(at) for ri in r for a in local]
+    firsts += [sp.diff(-_load_energy(fw, pos), a).subs(at) for a in local]
+    return len(local), hess, cjac, firsts
+
+
+def _load_energy(fw: Framework, pos: _Positions):
+    """sum F . x over the loads (V has it with a minus sign)."""
+    return sum(
+        (sp.Matrix([sp.Symbol(f"f_{ld.name}_{a}") for a in _AXES[: fw.dim]]).dot(pos.of(ld.point))
+         for ld in fw.loads), sp.Integer(0))  # fmt: skip
+
+
+def local_frame(fw: Framework) -> tuple[list, dict, _Positions, list, list]:
+    """(local coordinates, their values at the solution, positions as functions of them, the
+    constraints (g, multiplier, kind, description), the loads' energy sum F . x): the second-order
+    terms of the energy at a solution (X as symbols) are derivatives in the local coordinates."""
+    lay = layout(fw)
+    rot_syms = {b: [sp.Symbol(n) for n in rotation_names(fw.dim, b)] for b in lay.rotations}
+    config, _ = _unknowns(fw, lay)
+    local, at, pos = _local_frame(fw, lay, rot_syms, config)
+    return local, at, pos, _constraints(fw, lay, pos), _load_energy(fw, pos)
+
+
+def _local_frame(fw: Framework, lay: Layout, rot_syms: dict, config: list[str]) -> tuple:
+    """Local coordinates around a solution, the values that put them at it, and the positions.
 
     A rotation is perturbed as R0 R(delta) (planar) or q0 (sqrt(1 - |v|^2), v) (spatial), so the
     unit-length constraints are built in; translations and nodes are their own coordinates."""
@@ -258,29 +313,5 @@ def _second_order(fw: Framework, lay: Layout, rot_syms: dict, taut: tuple[str, .
     trans = [sp.Symbol(v) for v in config if not any(v in rotation_names(dim, b)
                                                     for b in lay.rotations)]  # fmt: skip
     local += trans
-    pos = _Positions(fw, lay, rot)
-    V = sp.Integer(0)
-    zfl = set(fw.zero_free_length())
-    for x in _active(fw, taut):
-        r = pos.of(x.a) - pos.of(x.b)
-        k, L0 = sp.Symbol(f"k_{x.name}"), sp.Symbol(f"L0_{x.name}")
-        V += k / 2 * (r.dot(r) if x.name in zfl else (sp.sqrt(r.dot(r)) - L0) ** 2)
-    for load in fw.loads:
-        f = sp.Matrix([sp.Symbol(f"f_{load.name}_{a}") for a in _AXES[:dim]])
-        V -= f.dot(pos.of(load.point))
-    cons = _constraints(fw, lay, pos)
-    L = V + sum(sp.Symbol(name) * g for g, name, _, _ in cons)
     at = {s: 0 for s in local[: len(local) - len(trans)]}
-    hess = [sp.diff(L, a, b).subs(at) for a in local for b in local]
-    cjac = [sp.diff(g, a).subs(at) for g, *_ in cons for a in local]
-    # First order, for cone points: each active link's vector r and dr/dlocal, and the loads'
-    # energy gradient.
-    firsts = []
-    for x in _active(fw, taut):
-        r = pos.of(x.a) - pos.of(x.b)
-        firsts += [ri.subs(at) for ri in r] + [sp.diff(ri, a).subs(at) for ri in r for a in local]
-    load_energy = sum(
-        (-sp.Matrix([sp.Symbol(f"f_{ld.name}_{a}") for a in _AXES[:dim]]).dot(pos.of(ld.point))
-         for ld in fw.loads), sp.Integer(0))  # fmt: skip
-    firsts += [sp.diff(load_energy, a).subs(at) for a in local]
-    return len(local), hess, cjac, firsts
+    return local, at, _Positions(fw, lay, rot)

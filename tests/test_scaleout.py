@@ -108,12 +108,12 @@ def random_system(rng, sizes: list[int]) -> tuple[PolySystem, list[list[str]]]:
     return PolySystem(tuple(names), eqs, tuple(exps), tuple(coefs)), groups
 
 
-def g_values(start, point: np.ndarray) -> np.ndarray:
-    """G at `point` from its rendered text, evaluated by sympy (not by start.evaluate)."""
-    subs = dict(zip(sympy.symbols(start.variables), point, strict=True))
-    return np.array(
-        [complex(sympy.sympify(t, locals={"I": sympy.I}).subs(subs)) for t in start.texts()]
-    )
+def g_values(start, points: np.ndarray) -> np.ndarray:
+    """G at each point from its rendered text (parsed by sympy; not start.evaluate)."""
+    xs = sympy.symbols(start.variables)
+    exprs = [sympy.sympify(t, locals={"I": sympy.I}) for t in start.texts()]
+    f = sympy.lambdify(xs, exprs, "numpy")
+    return np.array([f(*p) for p in points], dtype=complex)
 
 
 def test_start_system_roots_count_and_solve_g():
@@ -127,23 +127,13 @@ def test_start_system_roots_count_and_solve_g():
             start = linear_product_start(system, groups, seed=3)
         points = np.array(list(start.points()))
         assert len(points) == start.count() == bezout(start.degrees, sizes)
-        for p in points[:: max(1, len(points) // 6)]:  # sympy is slow: a sample of the roots
-            assert np.abs(g_values(start, p)).max() < 1e-10
+        assert np.abs(g_values(start, points)).max() < 1e-10
         assert max(np.abs(start.evaluate(p)).max() for p in points) < 1e-10
+        chunks = list(start.chunks(5))
+        assert np.array_equal(np.vstack(chunks), points) and max(map(len, chunks)) <= 5
         gaps = [np.abs(points[k + 1 :] - points[k]).max(axis=1).min(initial=1) for k in
                 range(len(points))]  # fmt: skip
         assert min(gaps) > 1e-6  # distinct roots: the count is a count of solutions
-
-
-def test_start_system_count_on_a_framework_equals_bertinis():
-    fw = cb.Framework.from_toml(ZEEMAN)
-    fs = framework_system(fw, taut_sets(fw)[0])
-    system = fs.ps.instantiate([1.0 + 0.2j * k for k in range(len(fs.ps.parameters))])
-    groups = variable_groups(fs)
-    start = linear_product_start(system, groups, seed=1)
-    assert start.count() == bezout(start.degrees, [len(g) for g in groups])
-    gs = homotopy.generic_set(fs.ps, 11, use_cache=False, centre=_centre(fw, fs), groups=groups)
-    assert start.count() == gs.paths  # Bertini's own multihomogeneous start: the same count
 
 
 def _centre(fw, fs) -> dict:
@@ -166,14 +156,8 @@ def same_sets(a: np.ndarray, b: np.ndarray, tol: float = 1e-8) -> bool:
     return True
 
 
-def test_split_generic_set_equals_bertinis_on_a_two_body_chain(scheduler, tmp_path):
-    path = tmp_path / "tiny_chain.toml"
-    path.write_text(TINY_CHAIN)
-    fw = cb.Framework.from_toml(path)
-    fs = framework_system(fw, taut_sets(fw)[0])
-    kw = {"use_cache": False, "centre": _centre(fw, fs), "groups": variable_groups(fs)}
-    own = homotopy.generic_set(fs.ps, 3, scheduler=scheduler, **kw)
-    theirs = homotopy.generic_set(fs.ps, 3, **kw)
+def assert_same_generic_set(own, theirs) -> None:
+    """Two routes to one generic set: same key, path count, finite, singular, nonsingular set."""
     assert own.route["method"].startswith("own multihomogeneous")
     assert theirs.route["method"].startswith("bertini multihomogeneous")
     assert own.key == theirs.key and own.paths == theirs.paths
@@ -184,12 +168,28 @@ def test_split_generic_set_equals_bertinis_on_a_two_body_chain(scheduler, tmp_pa
     assert len(own.points) > 0 and same_sets(own.points, theirs.points)
 
 
+def test_split_generic_set_equals_bertinis_on_zeeman(scheduler):
+    fw = cb.Framework.from_toml(ZEEMAN)
+    fs = framework_system(fw, taut_sets(fw)[0])
+    groups = variable_groups(fs)
+    kw = {"use_cache": False, "centre": _centre(fw, fs), "groups": groups}
+    own = homotopy.generic_set(fs.ps, 3, scheduler=scheduler, **kw)
+    theirs = homotopy.generic_set(fs.ps, 3, **kw)
+    assert_same_generic_set(own, theirs)
+    assert own.route["chunks"] >= 2 and sum(own.route["paths_per_chunk"]) == own.paths
+    # Our path count is the Bezout number, counted independently, and Bertini's own count.
+    start = linear_product_start(fs.ps.instantiate([1.0] * len(fs.ps.parameters)), groups, 1)
+    assert own.paths == bezout(start.degrees, [len(g) for g in groups])
+
+
 def _generic_files(folder: Path) -> dict[str, dict]:
     return {p.name: json.loads(p.read_text()) for p in folder.glob("generic-*.json")}
 
 
 def test_solve_with_scheduler_equals_solve_without(scheduler, tmp_path, monkeypatch):
-    fw = cb.Framework.from_toml(ZEEMAN)
+    path = tmp_path / "tiny_chain.toml"
+    path.write_text(TINY_CHAIN)
+    fw = cb.Framework.from_toml(path)  # two bodies: the split route on a torus framework
     solved = {}
     for name, options in (("split", {"scheduler": scheduler}), ("bertini", {})):
         monkeypatch.setenv("COTM_CACHE", str(tmp_path / name))  # generic sets solved afresh
@@ -204,13 +204,7 @@ def test_solve_with_scheduler_equals_solve_without(scheduler, tmp_path, monkeypa
     a, b = _generic_files(tmp_path / "split"), _generic_files(tmp_path / "bertini")
     assert sorted(a) == sorted(b) and len(a) == 2
     for name in a:
-        ga, gb = (homotopy.GenericSet.from_json(x[name]) for x in (a, b))
-        assert (ga.paths, ga.finite_endpoints, ga.singular_endpoints) == (
-            gb.paths,
-            gb.finite_endpoints,
-            gb.singular_endpoints,
-        )
-        assert same_sets(ga.points, gb.points)
+        assert_same_generic_set(*(homotopy.GenericSet.from_json(x[name]) for x in (a, b)))
     for view in ("physical", "stable"):
         x, y = getattr(split, view), getattr(plain, view)
         assert len(x) == len(y) > 0
@@ -231,14 +225,18 @@ def test_old_generic_cache_without_route_loads():
     assert old.route == homotopy.EARLIER_ROUTE and old.paths == 4
 
 
-def test_unreachable_scheduler_is_one_line_exit_2_nothing_written(tmp_path):
-    out = tmp_path / "runs"
-    for address in ("tcp://127.0.0.1:9", "nonsense"):
-        env = {"COTM_CACHE": str(tmp_path / "c"), CONNECT: "1s"}
-        res = run_cli("solve", "--framework", str(ZEEMAN), "--scheduler", address, "--no-cache",
-                      "--out", str(out), "--quiet", env=env)  # fmt: skip
-        assert res.returncode == 2, res.stderr
-        lines = res.stderr.strip().splitlines()
-        assert len(lines) == 1 and re.search(r"scheduler = '.*': no Dask scheduler", lines[0])
-        assert not out.exists()
-    assert not list((tmp_path / "c").glob("generic-*.json"))
+def test_unreachable_scheduler_is_one_line_exit_2_nothing_written(tmp_path, monkeypatch):
+    out, cache = tmp_path / "runs", tmp_path / "cache"
+    env = {"COTM_CACHE": str(cache), CONNECT: "1s"}  # nothing listens on port 9
+    res = run_cli("solve", "--framework", str(ZEEMAN), "--scheduler", "tcp://127.0.0.1:9",
+                  "--no-cache", "--out", str(out), "--quiet", env=env)  # fmt: skip
+    assert res.returncode == 2, res.stderr
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and re.search(r"scheduler = '.*:9': no Dask scheduler", lines[0])
+    assert not out.exists() and not list(cache.glob("**/generic-*.json"))
+    monkeypatch.setenv("COTM_CACHE", str(cache))
+    with pytest.raises(cb.ParameterError, match="scheduler = 'nonsense': no Dask scheduler"):
+        cb.solve(cb.Framework.from_toml(ZEEMAN), scheduler="nonsense")
+    assert not list(cache.glob("**/generic-*.json")) and not list(cache.glob("solves/*"))
+    with pytest.raises(cb.ParameterError, match="scheduler = 'tcp://h:1': .* engine='homotopy'"):
+        cb.Settings(engine="cli", scheduler="tcp://h:1")

@@ -189,21 +189,24 @@ def load_spec(folder: Path) -> SweepSpec:
     return SweepSpec.from_json(json.loads(path.read_text())["spec"])
 
 
-def warm_generic_sets(spec: SweepSpec) -> None:
-    """Solve (or load) the generic sets every point needs, once, before workers start."""
-    if Settings(**spec.settings).engine != "homotopy":
+def warm_generic_sets(spec: SweepSpec, scheduler: str | None = None) -> None:
+    """Solve (or load) the generic sets every point needs, once, before workers start; a set
+    solved now has its paths split over the Dask cluster at `scheduler`, if given."""
+    settings = Settings(**spec.settings)
+    if settings.engine != "homotopy":
         return
+    scheduler = scheduler or settings.scheduler
     if spec.framework is not None:
         from .framework import warm_generic_sets as framework_sets
 
-        framework_sets(spec.params_at, sorted({0, spec.size() - 1}), spec.settings["seed"])
+        framework_sets(spec.params_at, sorted({0, spec.size() - 1}), settings.seed, scheduler)
         return
     from ..backends.homotopy import generic_set
     from ..model.compiled import parametric_system
 
     structures = {spec.params_at(i).zfl for i in range(spec.size())}
     for zfl in sorted(structures):
-        generic_set(parametric_system(zfl), spec.settings["seed"])
+        generic_set(parametric_system(zfl), settings.seed, scheduler=scheduler)
 
 
 def run_points(
@@ -228,7 +231,7 @@ def run_points(
     stats["seconds"] = 0.0
     if not todo:
         return stats
-    warm_generic_sets(spec)
+    warm_generic_sets(spec, scheduler)
     start = time.perf_counter()
     runs = spec.runs(todo, parts=1 if (workers == 1 and scheduler is None) else 2 * workers)
     names = sweep_names(spec)
@@ -254,11 +257,10 @@ def _execute(
         return
     tasks = [(run, spec.to_json(), names) for run in runs]
     if scheduler is not None:
-        from distributed import Client, as_completed
+        from ..backends.dask_jobs import run_jobs
 
-        with Client(scheduler) as client:
-            for fut in as_completed(client.map(_run_task, tasks, pure=False)):
-                yield from fut.result()
+        for _, rows in run_jobs(_run_task, tasks, scheduler):
+            yield from rows
         return
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor, as_completed

@@ -1,0 +1,91 @@
+"""Scale-out (issue 18): one framework's first generic solve (seed 1, its first taut set) by
+Bertini's own start system in one call, and split in chunks over a Dask LocalCluster of 1 and
+2 worker processes (our own linear-product start system); times, paths per second, counts, and
+whether the sets agree. Usage: python bench/scaleout.py [--example prism] [--workers 1 2]
+(the prism takes minutes; the load average is printed: on a shared machine times are inflated).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from benchlib import BENCH, show, write_csv
+
+ROOT = BENCH.parent
+
+
+def _system(name: str):
+    """The first taut set's system of examples/<name>.toml, its start centre and groups."""
+    import cotm_bertini as cb
+    from cotm_bertini.model.framework.compiled import framework_system, variable_groups
+    from cotm_bertini.model.framework.units import normalized_slots
+    from cotm_bertini.point import taut_sets
+
+    fw = cb.Framework.from_toml(ROOT / "examples" / f"{name}.toml")
+    fs = next(f for f in (framework_system(fw, t) for t in taut_sets(fw)) if not f.free)
+    centre = normalized_slots(fw.at_defaults())
+    return fs.ps, {n: centre[n] for n in fs.ps.parameters}, variable_groups(fs)
+
+
+def _same(a: np.ndarray, b: np.ndarray, tol: float = 1e-8) -> bool:
+    """The two sets of points agree (each row of a has a distinct match in b, relative tol)."""
+    if a.shape != b.shape:
+        return False
+    left = list(range(len(b)))
+    for p in a:
+        d = [np.abs(b[k] - p).max() / (1 + np.abs(p).max()) for k in left]
+        if min(d) > tol:
+            return False
+        left.pop(int(np.argmin(d)))
+    return True
+
+
+def _row(route: str, gs, wall: float, reference) -> dict:
+    return {"route": route, "seconds": wall, "paths": gs.paths,
+            "paths_per_s": gs.paths / wall, "finite": gs.finite_endpoints,
+            "nonsingular": len(gs.points), "singular": gs.singular_endpoints,
+            "chunks": gs.route.get("chunks", 1),
+            "same_set_as_bertini": "-" if reference is None else _same(gs.points, reference),
+            "load_avg_1min": os.getloadavg()[0]}  # fmt: skip
+
+
+def main() -> None:
+    """Print and write bench/results/scaleout.csv."""
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--example", default="prism")
+    ap.add_argument("--workers", nargs="*", type=int, default=[1, 2])
+    opts = ap.parse_args()
+    os.environ["COTM_CACHE"] = tempfile.mkdtemp(prefix="cotm-bench-scaleout-")
+    from distributed import LocalCluster
+
+    from cotm_bertini.backends.homotopy import generic_set
+
+    ps, centre, groups = _system(opts.example)
+    kw = {"use_cache": False, "centre": centre, "groups": groups}
+    t0 = time.perf_counter()
+    ref = generic_set(ps, 1, **kw)
+    rows = [_row("bertini start, one call (all cores)", ref, time.perf_counter() - t0, None)]
+    for n in opts.workers:
+        with LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                          dashboard_address=None) as cluster:  # fmt: skip
+            t0 = time.perf_counter()
+            gs = generic_set(ps, 1, scheduler=cluster.scheduler_address, **kw)
+            wall = time.perf_counter() - t0
+        rows.append(_row(f"own start, split on {n} worker(s)", gs, wall, ref.points))
+        print(f"{n} worker(s): chunk seconds {gs.route['chunk_seconds']}", file=sys.stderr)
+    frame = pd.DataFrame(rows)
+    print(f"\n{opts.example}: first generic set (seed 1, first taut set), {os.cpu_count()} cores")
+    show("scale-out: generic solve", frame, {"seconds": ".1f", "paths_per_s": ".2f"})
+    write_csv(frame, f"scaleout-{opts.example}")
+
+
+if __name__ == "__main__":
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    main()

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from conftest import solved
 from paper_tables import K_RATIO, TABLE2, TABLE2_COMPLEX, TABLE3, TABLE4
-from physics import angle_distance, balance, energy_gradient_fd, mp_refine
+from physics import angle_distance, balance, energy_gradient_fd, mp_refine, points
 
 
 def _unit(text: str) -> float:
@@ -154,3 +154,28 @@ def test_homotopy_engine_equals_ab_initio(case, k2):
     gaps = angle_gaps(ours, ref)
     tol = np.where(ref["singular"].to_numpy(), 1e-5, 1e-8)
     assert (gaps.min(axis=0) < tol).all() and gaps.min(axis=1).max() < 1e-5
+
+
+@pytest.mark.parametrize("l01, l02", [(10.08, 0.42), (10.36, 9.94)])
+def test_equilibrium_next_to_a_cone_point_is_kept(l01, l02):
+    """Near a cone point (a spring of L0 > 0 at zero length) a genuine equilibrium can have a
+    spring of 2.5e-5 m: nonsingular, it is physical, not a d = 0 artefact. These two points of
+    the 101 x 101 map failed the Morse count when it was dropped (stop 15)."""
+    import cotm_bertini as cb
+
+    p = cb.Params().replace(L01=l01, L02=l02)
+    res = cb.solve(p)
+    assert res.morse["ok"], res.morse
+    short = res.physical[np.minimum(res.physical.d1, res.physical.d2) < 0.1]
+    assert len(short), "the equilibrium next to the cone point is missing"
+    for _, row in short.iterrows():
+        # 40-digit Newton on the balance equations (tests/physics.py, no package code) lands
+        # on the row, and its springs have positive length there: a true equilibrium.
+        # The polynomial system is ill-conditioned there (condition number 4e9 to 1e10: the force
+        # density is k L0 / d), so double precision places the row to ~1e-5 deg only.
+        g1, g2 = mp_refine(p, row.gamma1_deg, row.gamma2_deg)
+        assert angle_distance(g1, row.gamma1_deg) < 1e-4
+        assert angle_distance(g2, row.gamma2_deg) < 1e-4
+
+        pt = points(p, np.radians(g1), np.radians(g2))
+        assert np.linalg.norm(pt[5] - pt[3]) > 0 and np.linalg.norm(pt[6] - pt[2]) > 0

@@ -179,7 +179,7 @@ def classify_columns(
         "gamma2_imag_deg": gam2.imag,
         "paths": np.array(merged.paths, dtype=object),
     }
-    cols.update(_physical_columns(params, v, d, is_real, tol))
+    cols.update(_physical_columns(params, v, d, is_real, merged.singular, tol))
     stable_ok = cols["physical"] & ~merged.singular
     cols.update(mechanics(params, cols["physical"], g1r, g2r, vec, stable_ok, tol.hessian))
     cols["paper_stable"] = paper_criterion(params, cols)
@@ -189,14 +189,16 @@ def classify_columns(
     return _order(cols, variables)
 
 
-def _physical_columns(params, v, d, is_real, tol: Tolerances) -> dict[str, np.ndarray]:
+def _physical_columns(params, v, d, is_real, singular, tol: Tolerances) -> dict[str, np.ndarray]:
     """`reason` and `physical`: real, both spring lengths > 0, not a d = 0 artefact."""
+    # d = 0 with L0 > 0 is never an equilibrium (the force direction is undefined): the
+    # double roots where one spring collapses (singular), and the complex points where both do
+    # (nonsingular). A nonsingular root with one tiny d is a genuine equilibrium next to a cone
+    # point (a saddle at d2 = 2.5e-5 m with L01 = 10.08, L02 = 0.42).
+    short = [np.abs(v[f"d{i}"]) < tol.zero_length * params.L3 for i in (1, 2) if f"d{i}" in v]
     zero = np.zeros(len(is_real), dtype=bool)
-    for i in (1, 2):
-        if f"d{i}" in v:
-            # d = 0 with L0 > 0 is never an equilibrium (the force direction is undefined):
-            # the double roots where one spring collapses, and the complex points where both do.
-            zero |= np.abs(v[f"d{i}"]) < tol.zero_length * params.L3
+    if short:
+        zero = (singular & np.logical_or.reduce(short)) | np.logical_and.reduce(short)
     negative = is_real & ((d[1] <= 0) | (d[2] <= 0)) & ~zero
     reason = np.select(
         [zero, ~is_real, negative], ["zero_length_spring", "complex", "negative_d"], default=""

@@ -1,10 +1,11 @@
 """Certification cost (issues 11, 17): the proof of each case against its own solve, and per
 random geometry; the proof's parts (rows, equilibria, completeness) and, with --torus, the
-earlier two-dimensional branch and bound for comparison. Prints; asserts nothing.
+earlier two-dimensional branch and bound for comparison; with --frameworks, the examples'
+certificates (issue 19) against their solves. Prints; asserts nothing.
 
 Each solve is the homotopy engine's, generic set warm, no cache (what `certify case3` runs the
 first time); each proof is cold (the parallel curve's cover is not reused between them).
-Usage: .venv/bin/python bench/certify.py [--random 20] [--torus]
+Usage: .venv/bin/python bench/certify.py [--random 20] [--torus] [--frameworks]
 """
 
 from __future__ import annotations
@@ -55,6 +56,41 @@ def one(params, label: str, torus: bool) -> dict:
     return row
 
 
+FRAMEWORKS = {"zeeman": {"x": 0.1, "y": -0.25}, "double_pendulum": {}, "cotm": {},
+              "fourbar": {}}  # fmt: skip
+
+
+def one_framework(name: str) -> dict:
+    """Solve (generic sets warm, no cache) and certify one example framework, both timed."""
+    import cotm_bertini as cb
+    from cotm_bertini.analysis.certify_framework import certify_framework_table
+    from cotm_bertini.point import solve_framework_point
+
+    root = Path(__file__).resolve().parent.parent
+    fw = cb.Framework.from_toml(root / "examples" / f"{name}.toml").replace(**FRAMEWORKS[name])
+    solve_framework_point(fw)  # warm: generic sets and generated code loaded
+    start = time.perf_counter()
+    solved = solve_framework_point(fw)
+    solve_s = time.perf_counter() - start
+    cert = certify_framework_table(fw, solved.columns)
+    return {
+        "framework": name, "solve_s": solve_s, "certify_s": cert.seconds,
+        "ratio": cert.seconds / solve_s, "rows_s": cert.timings["rows"],
+        "complete_s": cert.timings["completeness"], "status": cert.status,
+        "equilibria": cert.proved_equilibria, "rows_certified": int(cert.certified.sum()),
+        "rows": len(cert.certified), "boxes": cert.boxes, "excluded": cert.excluded_boxes,
+    }  # fmt: skip
+
+
+def frameworks() -> None:
+    """The examples' certificates against their solves."""
+    table = pd.DataFrame([one_framework(n) for n in FRAMEWORKS])
+    formats = {k: ".3f" for k in ("solve_s", "certify_s", "rows_s", "complete_s")}
+    show("Frameworks: certification against the solve (seconds, 2 cores)", table,
+         {**formats, "ratio": ".2f"})  # fmt: skip
+    write_csv(table, "certify_frameworks")
+
+
 def main() -> None:
     from test_stress import random_params
 
@@ -63,7 +99,11 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--random", type=int, default=20, help="random geometries to certify")
     ap.add_argument("--torus", action="store_true", help="also time the 2-D branch and bound")
+    ap.add_argument("--frameworks", action="store_true", help="only the example frameworks")
     args = ap.parse_args()
+    if args.frameworks:
+        frameworks()
+        return
     rows = [one(Params.case(case), case, args.torus) for case in ("case1", "case2", "case3")]
     rows += [one(random_params(s), f"random {s}", args.torus) for s in range(1, args.random + 1)]
     table = pd.DataFrame(rows)

@@ -45,7 +45,8 @@ SOLUTIONS = {
     "is proved (Krawczyk, ball arithmetic) in the box around this row, real if the row is real, "
     "non-real if not; singular rows (double roots) cannot be",
     "certified_radius": "after `--certify` only: the half-width of that box in every variable, in "
-    "units of L3 for d (NaN where not certified)",
+    "units of L3 for d (NaN where not certified); for a framework the largest half-width, in its "
+    "normalised units (each variable's relative to its own size), and complex rows not tried",
 }
 
 SWEEP = {

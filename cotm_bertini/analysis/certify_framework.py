@@ -36,20 +36,42 @@ from .certify_torus import Landscape, krawczyk_box, torus_search
 SHORT = 1e-3  # springs shorter than this (framework length units) are set aside at cone points
 MIN_WIDTH = 1e-4  # radians: the smallest box away from a known equilibrium
 ROOT_BOX = 1e-7  # radians: the half-width of the box proving each equilibrium in the angles
-SLOT_RADIUS = 2.0**-50  # relative radius of a slot's ball: holds the decimal the file wrote
+DECIMAL = 2.0**-53  # a decimal read as a double is within this (relative) of it
 
 
-def slot_balls(fw: Framework) -> list:
-    """Every slot in the framework's units as a ball holding the file's value (the double of a
-    decimal, or of an expression of decimals, is within a few roundings of it), in slot order."""
+def slot_balls(fw: Framework, exact: bool = False) -> list:
+    """Every slot in the framework's units as a ball, in slot order: its expression evaluated in
+    ball arithmetic, each number of the file (and each parameter value) a ball holding the
+    decimal it was read from (a double is within half an ulp of it); with `exact`, the doubles
+    themselves (the numbers as given, exact, as the paper's certificate takes them)."""
     from flint import arb
 
     length, stiffness = (arb(u) for u in units(fw))
     unit = {"len": length, "k": stiffness, "force": stiffness * length}
+    rel = 0.0 if exact else DECIMAL
+
+    def number(v: float):
+        return arb(v, abs(v) * rel) if v and rel else arb(v)
+
+    values = {n: number(float(v)) for n, v in fw.values.items()}
     return [
-        (arb(v, abs(v) * SLOT_RADIUS) if v else arb(0)) / unit[slot_kind(name)]
-        for name, v in fw.slots().items()
+        _evaluate(e, values, number) / unit[slot_kind(name)]
+        for name, e in fw.slot_expressions().items()
     ]
+
+
+def _evaluate(e, values: dict, number):
+    """An expression (model.framework.expressions.Expr) in ball arithmetic."""
+    if e.op == "num":
+        return number(e.value)
+    if e.op == "name":
+        return values[e.name]
+    a = [_evaluate(x, values, number) for x in e.args]
+    if e.op == "neg":
+        return -a[0]
+    ops = {"+": lambda x, y: x + y, "-": lambda x, y: x - y, "*": lambda x, y: x * y,
+           "/": lambda x, y: x / y, "^": lambda x, y: x**y}  # fmt: skip
+    return ops[e.op](a[0], a[1])
 
 
 def _ball(v):
@@ -66,6 +88,7 @@ class _Rows:
     radius: np.ndarray
     physical: dict[int, str] = field(default_factory=dict)  # row -> yes, no, unknown
     kinds: dict[int, str] = field(default_factory=dict)  # solution_id -> proved kind
+    as_doubles: list[int] = field(default_factory=list)  # proved with the doubles exact only
 
 
 def _row_points(fw: Framework, fs: FrameworkSystem, table, rows: np.ndarray) -> tuple:
@@ -104,28 +127,38 @@ def _row_points(fw: Framework, fs: FrameworkSystem, table, rows: np.ndarray) -> 
     return np.nan_to_num(x).astype(complex), system
 
 
-def certify_rows(fw: Framework, table, P: list) -> _Rows:
+def certify_rows(fw: Framework, table, P: list, exact: list) -> _Rows:
     """Parts 1 and 2 for every row (rows by position): proved, box half-width (normalised),
-    and for the proved physical ones consistency and kind."""
+    and for the proved physical ones consistency and kind. `P`: the slots as balls holding the
+    file's decimals; a row not proved with them is tried with `exact` (the doubles, exact) and,
+    if proved so, listed in `as_doubles`."""
     n = len(table["solution_id"])
     out = _Rows(np.zeros(n, dtype=bool), np.full(n, np.nan))
     real = np.asarray(table["is_real"], dtype=bool)
     singular = np.asarray(table["singular"], dtype=bool)
     sets = np.asarray(table["taut_set"], dtype=object)
-    names = {p: ball for p, ball in zip(fw.slots(), P, strict=True)}
     for label in sorted(set(sets)):
         rows = np.flatnonzero((sets == label) & real & ~singular)
         if not len(rows):
             continue
         fs = framework_system(fw, tuple(label.split()))
         points, system = _row_points(fw, fs, table, rows)
-        proved, radius, centres = certify_points(
-            lambda fs=fs: ball_system_of(fs.ps, names), system, points, np.ones(len(rows), bool)
-        )
-        out.certified[rows], out.radius[rows] = proved, radius
-        for row, ok, r, centre in zip(rows, proved, radius, centres, strict=True):
-            if ok:
-                _judge(fw, fs, table, int(row), [_real_ball(z, r) for z in centre], P, out)
+        for slots in (P, exact):
+            todo = ~out.certified[rows]
+            if not todo.any():
+                break
+            names = dict(zip(fw.slots(), slots, strict=True))
+            proved, radius, boxes = certify_points(
+                lambda fs=fs, names=names: ball_system_of(fs.ps, names), system, points[todo],
+                np.ones(int(todo.sum()), bool), each=True,
+            )  # fmt: skip
+            for row, ok, r, proof in zip(rows[todo], proved, radius, boxes, strict=True):
+                if ok:
+                    out.certified[row], out.radius[row] = True, r
+                    if slots is exact:
+                        out.as_doubles.append(int(table["solution_id"][row]))
+                    X = [_real_ball(z, r) for z, r in zip(*proof, strict=True)]
+                    _judge(fw, fs, table, int(row), X, slots, out)
     return out
 
 
@@ -253,10 +286,10 @@ def certify_framework_table(
     start = time.perf_counter()
     bits, ctx.prec = ctx.prec, WORKING_BITS
     try:
-        P = slot_balls(fw)
+        P, exact = slot_balls(fw), slot_balls(fw, exact=True)
     finally:
         ctx.prec = bits
-    rows = certify_rows(fw, table, P)
+    rows = certify_rows(fw, table, P, exact)
     t_rows = time.perf_counter()
     contradictions = _row_contradictions(table, rows)
     scope = _completeness_scope(fw)
@@ -363,6 +396,11 @@ def _verdict(table, rows: _Rows, proof, scope: str, contradictions: list, length
             f"({int(singular.sum())} singular double roots cannot be; "
             f"{int((~real & ~singular).sum())} complex rows not tried: the table keeps their "
             "real parts only)")  # fmt: skip
+    if rows.as_doubles:
+        tail += (
+            f"; solutions {sorted(rows.as_doubles)} proved for the file's numbers as "
+            "doubles only (their decimals' half-ulp moves them more than the box allows)"
+        )
     if open_rows or unsure:
         tail += f"; not proved: solutions {sorted(set(open_rows + unsure))}"
     if proof is None:

@@ -152,13 +152,16 @@ def prepare(system: BallSystem, y: np.ndarray, c: np.ndarray, near: np.ndarray,
     return _Centre(centre, ym, acb_mat([[f] for f in evaluate(system, centre)]))
 
 
-def krawczyk(system: BallSystem, prepared: _Centre, r: float) -> bool:
-    """Whether the box of half-width r around the prepared centre holds exactly one solution:
-    K(X) = c - Y F(c) + (I - Y J(X)) (X - c) inside the interior of X."""
+def krawczyk(system: BallSystem, prepared: _Centre, r) -> bool:
+    """Whether the box of half-width r (a number, or one per variable) around the prepared
+    centre holds exactly one solution: K(X) = c - Y F(c) + (I - Y J(X)) (X - c) inside the
+    interior of X."""
     from flint import acb, acb_mat, arb
 
     centre, n = prepared.centre, len(prepared.centre)
-    box = [acb(arb(z.real.mid(), r), arb(z.imag.mid(), r)) for z in centre]
+    rs = np.broadcast_to(np.asarray(r, dtype=float), (n,))
+    box = [acb(arb(z.real.mid(), float(ri)), arb(z.imag.mid(), float(ri)))
+           for z, ri in zip(centre, rs, strict=True)]  # fmt: skip
     jx = acb_mat(jacobian(system, box))
     ident = acb_mat([[1 if i == j else 0 for j in range(n)] for i in range(n)])
     diff = acb_mat([[box[i] - centre[i]] for i in range(n)])
@@ -206,11 +209,13 @@ def certify_rows(params: Params, table) -> tuple[np.ndarray, np.ndarray]:
     return proved, radius
 
 
-def certify_points(make_system, numeric, points: np.ndarray, real: np.ndarray) -> tuple:
+def certify_points(make_system, numeric, points: np.ndarray, real: np.ndarray,
+                   each: bool = False) -> tuple:  # fmt: skip
     """Krawczyk around each point of a polynomial system (normalised units): (proved, box
-    half-width or NaN, the proved centres as acb lists or None). `make_system()` builds the
-    BallSystem (at the working precision); `numeric`: the same system in double precision
-    (evaluate, jacobian) for the Newton refinement of the starts."""
+    half-width or NaN (the largest, with `each`), the proved boxes as (acb centre list,
+    half-widths) or None). `make_system()` builds the BallSystem (at the working precision);
+    `numeric`: the same system in double precision (evaluate, jacobian) for the Newton
+    refinement of the starts; `each`: radii per variable (`_prove`)."""
     from flint import ctx
 
     near = _newton(numeric, points) if len(points) else points
@@ -228,21 +233,25 @@ def certify_points(make_system, numeric, points: np.ndarray, real: np.ndarray) -
         system = make_system() if len(points) else None
         for row, (start, y, ok) in enumerate(zip(near, inverses, invertible, strict=True)):
             if ok:
-                proved[row], radius[row], centres[row] = _prove(
-                    system, points[row], start, y, real[row]
-                )
+                ok, r, centre = _prove(system, points[row], start, y, real[row], each)
+                if ok:
+                    rs = np.broadcast_to(np.asarray(r, dtype=float), (n,))
+                    proved[row], radius[row], centres[row] = True, rs.max(), (centre, rs)
     finally:
         ctx.prec = bits
     return proved, radius, centres
 
 
-def _prove(system: BallSystem, c: np.ndarray, start: np.ndarray, y: np.ndarray,
-           real: bool) -> tuple[bool, float, list | None]:  # fmt: skip
+def _prove(system: BallSystem, c: np.ndarray, start: np.ndarray, y: np.ndarray, real: bool,
+           each: bool = False) -> tuple[bool, object, list | None]:  # fmt: skip
     """(proved, box half-width, the box's centre) for one row: the double-precision centre
     first, then one Newton step in ball arithmetic with each radius in turn (an
-    ill-conditioned root)."""
-    scale = 1 + float(np.abs(c).max())
-    for steps, radii in ((0, RADII[:1]), (1, RADII)):
+    ill-conditioned root). The radii are relative to 1 + max |c|, or with `each` to 1 + |c_i|
+    per variable (a box as wide as each variable's own scale: a force density a thousand times
+    the others, at a spring of nearly zero length, needs it) and then down to 1e-15."""
+    scale = 1 + (np.abs(c) if each else float(np.abs(c).max()))
+    radii_all = RADII if not each else (1e-15, 1e-14, 1e-13, *RADII, 1e-5, 1e-4)
+    for steps, radii in ((0, RADII[:1]), (1, radii_all)):
         prepared = prepare(system, y, c, start, steps)
         for r in (rel * scale for rel in (radii if prepared is not None else ())):
             if not real and (np.abs(c.imag) <= r).all():

@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 from ..errors import CertificateError
-from .solutions import Solutions, paper_only
+from ..params import Params
+from .solutions import Solutions
 
 
 def certify(res: Solutions, strict: bool = True):
@@ -11,15 +12,25 @@ def certify(res: Solutions, strict: bool = True):
     equilibrium is missing (the relaxed ones by branch and bound, the others along the parallel
     curve a1 x a2 = 0, enclosed in ball arithmetic); docs/certify.md says what exactly.
 
+    A framework (cb.Framework): every real row proved on its taut set's system, with its
+    consistency and kind; completeness by branch and bound where its poses form a circle or a
+    torus and no cable makes V piecewise; elsewhere the status is 'rows proved' and the
+    statement says completeness is not proved (docs/certify.md, "Frameworks").
+
     Returns the Certificate and attaches it to `res` (`res.certificate`; `res.table` gains the
     columns `certified` and `certified_radius`; `res.save` writes them and a `certificate` block
     in run.json). With `strict` (default), a difference between the proof and the table raises
     CertificateError (the certificate is still attached: save the run to keep the evidence).
     """
-    from ..analysis.certify import certify_table
+    table = res.table.reset_index(drop=True)  # rows by position
+    if isinstance(res.params, Params):
+        from ..analysis.certify import certify_table
 
-    paper_only(res, "certify")
-    cert = certify_table(res.params, res.table.reset_index(drop=True))  # rows by position
+        cert = certify_table(res.params, table)
+    else:
+        from ..analysis.certify_framework import certify_framework_table
+
+        cert = certify_framework_table(res.params, table)
     res.attach_certificate(cert)
     if strict and cert.status == "contradiction":
         raise CertificateError("; ".join(cert.contradictions), cert)

@@ -138,14 +138,19 @@ def _start(spec: SweepSpec, index: int, zfl, recent: dict[int, tuple]):
 def _certify_point(params: Params, solved: PointSolution, cols: dict) -> None:
     """Prove the point (columns certified, certified_radius, certificate, certify_seconds); a
     point whose proof is not complete is `incomplete`."""
-    from ..analysis.certify import certify_table
+    if isinstance(params, Params):
+        from ..analysis.certify import certify_table
 
-    cert = certify_table(params, solved.columns)
+        cert = certify_table(params, solved.columns)
+    else:  # a framework (docs/certify.md, "Frameworks")
+        from ..analysis.certify_framework import certify_framework_table
+
+        cert = certify_framework_table(params, solved.columns)
     n = len(cols["point"])
     values = (cert.certified, cert.certified_radius, np.full(n, cert.status, dtype=object),
               np.full(n, cert.seconds))  # fmt: skip
     cols.update(zip(CERTIFY_COLUMNS, values, strict=True))
-    if cert.status != "proved":
+    if cert.status not in ("proved", "rows proved"):
         cols["status"] = np.full(n, "incomplete", dtype=object)
 
 

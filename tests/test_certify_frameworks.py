@@ -151,3 +151,12 @@ def test_certify_framework_cli(tmp_path):
     assert record["certificate"]["proved_equilibria"] == 2
     header = next(tmp_path.glob("*/solutions.csv")).read_text().splitlines()[0].split(",")
     assert "certified" in header and "certified_radius" in header
+
+
+def test_a_framework_sweep_certifies_every_point(tmp_path):
+    fw = cb.Framework.from_toml(EXAMPLES / "zeeman.toml")
+    table = cb.sweep(fw, "x", [0.0, 0.1], certify=True, out=tmp_path, workers=1).table
+    assert set(table["certificate"]) == {"proved"}
+    real = table["is_real"].astype(bool) & ~table["singular"].astype(bool)
+    assert table.loc[real, "certified"].astype(bool).all()
+    assert not table.loc[~real, "certified"].astype(bool).any()

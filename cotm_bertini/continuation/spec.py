@@ -80,8 +80,6 @@ class SweepSpec:
         object.__setattr__(self, "_model", fw.replace(**self.base))
         check_param(fw, self.param, "param")
         check_param(fw, self.param2, "param2")
-        if self.certify:
-            raise ParameterError("certify: proofs cover the paper's mechanism only, not frameworks")
         engine = self.settings.get("engine", "homotopy")
         if engine != "homotopy":
             raise ParameterError(

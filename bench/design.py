@@ -20,7 +20,12 @@ def main() -> None:
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--points", type=int, default=41, help="grid points a side of the map")
+    ap.add_argument("--zeeman-points", type=int, default=101, help="Zeeman map grid a side")
+    ap.add_argument("--zeeman-only", action="store_true", help="only the Zeeman map")
     args = ap.parse_args()
+    if args.zeeman_only:
+        framework_map(args.zeeman_points)
+        return
     p = cb.Params.case("case3")
     t0 = time.perf_counter()
     folds = cb.fold_curves(p)
@@ -51,6 +56,35 @@ def main() -> None:
         found = cb.barriers(res)
         print(f"  {case}: {len(found.table)} saddles, {len(found.pairs)} pairs, "
               f"{found.seconds:.2f} s")  # fmt: skip
+    framework_map(args.zeeman_points)
+
+
+def framework_map(points: int = 101) -> None:
+    """Zeeman's machine over the issue's window (target: the 101 x 101 map in 60 s or less):
+    wall time of the fold curves and of the regions (the 2-D sweep, 2 workers), and the CPU
+    time spent in this process and its workers (the wall time depends on the machine's load)."""
+    import resource
+
+    def cpu() -> float:
+        return sum(
+            r.ru_utime + r.ru_stime
+            for r in (
+                resource.getrusage(w) for w in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN)
+            )
+        )
+
+    fw = cb.Framework.from_toml("examples/zeeman.toml")
+    c0, t0 = cpu(), time.perf_counter()
+    m = cb.design_map(fw, "x", (-0.6, 0.8), "y", (-0.8, 0.2), points=points, workers=2)
+    seconds, cpu_seconds = time.perf_counter() - t0, cpu() - c0
+    rec, t = m.record, m.record["timings"]
+    print(f"== Zeeman map, {points} x {points}, 2 workers (target: 60 s or less) ==")
+    print(f"  {seconds:.1f} s in all: folds {t['folds']:.1f} s, regions {t['regions']:.1f} s "
+          f"({1e3 * t['regions'] / points**2:.1f} ms a grid point), check {t['check']:.2f} s; "
+          f"CPU {cpu_seconds:.1f} s")  # fmt: skip
+    print(f"  {rec['fold_points']} fold points on {rec['fold_curves']} curves, {rec['cusps']} "
+          f"cusps; {rec['count_changes']} stable-count changes, {rec['unexplained_changes']} "
+          f"unexplained; sweep {rec['sweep_status']}")  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -76,25 +76,41 @@ def test_direct_solves_either_side_differ_by_two(folds, index):
     assert abs(counts[0] - counts[1]) == 2
 
 
+def _neighbour_segments(folds, window) -> np.ndarray:
+    """The sampled fold curves as segments (window units, for region_changes.uncrossed): every
+    pair of fold points that are neighbouring samples of one curve (poses within 1 deg but not
+    the same pose, free lengths within 0.1 m), as in `_crossings`."""
+    (x0, x1), (y0, y1) = window
+    pts = folds[["L01", "L02", "gamma1_deg", "gamma2_deg"]].to_numpy(float)
+    pts = pts[np.argsort(pts[:, 0])]
+    ends = np.searchsorted(pts[:, 0], pts[:, 0] + 0.1)
+    segs = []
+    for i in range(len(pts)):
+        near = pts[i + 1 : ends[i]]
+        gap = np.abs((near[:, 2:] - pts[i, 2:] + 180) % 360 - 180).max(axis=1)
+        close = np.abs(near[:, 1] - pts[i, 1]) < 0.1
+        for q in near[(gap < 1.0) & (gap > 1e-9) & close]:
+            segs.append((pts[i, 0], pts[i, 1], q[0], q[1]))
+    scale = np.array([x1 - x0, y1 - y0] * 2)
+    return (np.array(segs) - np.array([x0, y0] * 2)) / scale
+
+
 def test_stable_count_changes_only_across_fold_curves(folds):
     """Completeness on the paper geometry: wherever direct solves on neighbouring grid points
     disagree on the number of stable equilibria, a fold curve crosses the segment between them
-    (41 x 41 over (0, 14] with COTM_STRESS=full, 11 x 11 otherwise)."""
+    (41 x 41 over (0, 14] with COTM_STRESS=full, 11 x 11 otherwise). The check is the one of
+    every framework's map (analysis.region_changes), on the paper's sampled curve."""
+    from cotm_bertini.analysis.region_changes import count_changes, grid_window, uncrossed
+
     n = 41 if os.environ.get("COTM_STRESS") == "full" else 11
     lo = 14.0 / n
     regions = cb.design_map(P, (lo, 14.0), (lo, 14.0), n, workers=2).regions
-    grid = regions.pivot(index="L02", columns="L01", values="stable")
-    xs, ys = grid.columns.to_numpy(float), grid.index.to_numpy(float)
-    changes = 0
-    for axis, fixed_values, moving in (("L02", ys, xs), ("L01", xs, ys)):
-        for v in fixed_values:
-            cut = _crossings(folds, v, axis)
-            line = grid.loc[v] if axis == "L02" else grid[v]
-            for a, b in zip(moving[:-1], moving[1:], strict=True):
-                if line.loc[a] != line.loc[b]:
-                    changes += 1
-                    assert ((cut > a - 1e-3) & (cut < b + 1e-3)).any(), (axis, v, a, b)
-    assert changes > 0
+    window = grid_window(regions, "L01", "L02")
+    changes = count_changes(regions, "L01", "L02")
+    segments = _neighbour_segments(folds, window)
+    missed = uncrossed(changes, segments, window, 1e-3 / (14.0 - lo))
+    assert len(changes) > 0
+    assert missed.empty, missed
 
 
 def _map_cli(*args: str) -> subprocess.CompletedProcess:

@@ -292,42 +292,85 @@ def barriers(args: argparse.Namespace) -> int:
     return EXIT_INCOMPLETE if found.warnings else EXIT_OK
 
 
+def _map_axes(args: argparse.Namespace, model) -> tuple[tuple, tuple]:
+    """((x, (from, to)), (y, (from, to))) of `map`: the paper's free lengths (0 to 14 m by
+    default), or two parameters of a framework, named with their ranges."""
+    from ..api.maps import FREE_LENGTHS, PAPER_WINDOW
+    from ..params import Params
+
+    if isinstance(model, Params):
+        x, y = args.param or FREE_LENGTHS[0], args.param2 or FREE_LENGTHS[1]
+        if {x, y} != set(FREE_LENGTHS):
+            raise ParameterError(
+                f"--param {x} --param2 {y}: the map is over the free lengths, "
+                "so the two axes must be L01 and L02"
+            )
+        ends = [args.start, args.stop, args.start2, args.stop2]
+        ends = [d if v is None else v for v, d in zip(ends, PAPER_WINDOW * 2, strict=True)]
+        return (x, tuple(ends[:2])), (y, tuple(ends[2:]))
+    known = " ".join(model.values) or "none"
+    axes = []
+    for which, suffix in (("param", ""), ("param2", "2")):
+        name = getattr(args, which)
+        if name is None:
+            raise ParameterError(
+                f"--{which} is required with --framework (its parameters: {known})"
+            )
+        if name not in model.values:
+            raise ParameterError(
+                f"--{which} {name!r}: not a parameter of framework {model.name!r} (known: {known})"
+            )
+        ends = getattr(args, "start" + suffix), getattr(args, "stop" + suffix)
+        for flag, v in zip(("--from", "--to"), ends, strict=True):
+            if v is None:
+                raise ParameterError(f"{flag}{suffix} is required for --{which} {name}")
+        axes.append((name, ends))
+    if axes[0][0] == axes[1][0]:
+        raise ParameterError(f"--param2 {axes[1][0]!r}: same as --param")
+    return axes[0], axes[1]
+
+
 def design_map(args: argparse.Namespace) -> int:
-    """`map`: fold curves and stable-count regions over the (L01, L02) plane."""
-    from ..api.maps import FREE_LENGTHS, SWEEP_FOLDER
+    """`map`: fold curves and stable-count regions over two parameters (the paper's free
+    lengths, or any two of a framework's)."""
+    from ..api.maps import SWEEP_FOLDER
     from ..api.maps import design_map as make_map
     from ..continuation.runner import default_workers
+    from ..params import Params
 
-    if {args.param, args.param2} != set(FREE_LENGTHS):
-        raise ParameterError(
-            f"--param {args.param} --param2 {args.param2}: the map is over the free lengths, "
-            "so the two axes must be L01 and L02"
-        )
+    model = params_from(args)
+    (x, xr), (y, yr) = _map_axes(args, model)
     workers = default_workers() if args.workers is None else args.workers
     if workers < 1:
         raise ParameterError(f"--workers {workers}: must be >= 1")
     if args.points < 2:
         raise ParameterError(f"--points {args.points}: a map needs at least 2 points a side")
-    ranges = {args.param: (args.start, args.stop), args.param2: (args.start2, args.stop2)}
     root = output_root(args.out)
     found = make_map(
-        params_from(args), ranges["L01"], ranges["L02"], args.points, settings_from(args),
+        model, x, xr, y, yr, points=args.points, settings=settings_from(args),
         workers=workers, progress=not args.quiet,
     )  # fmt: skip
     folder = found.save(new_run_folder(root), plots=not args.no_plots)
     link_latest(root, folder)
     counts = found.regions.stable.value_counts().sort_index()
     spread = ", ".join(f"{n} stable: {c} points" for n, c in counts.items())
-    cusps = int((found.folds.kind == "cusp").sum())
-    pieces = found.record["fold_curves"]
-    (lo1, hi1), (lo2, hi2) = found.record["window"]["L01"], found.record["window"]["L02"]
+    rec, unit, (x, y) = found.record, " m" if isinstance(model, Params) else "", found.axes
+    (lo1, hi1), (lo2, hi2) = rec["window"][x], rec["window"][y]
     print(
-        f"map: in the window L01 {lo1:g}..{hi1:g} m, L02 {lo2:g}..{hi2:g} m: "
-        f"{len(found.folds)} fold points on {pieces} pieces, {cusps} cusps; {spread}"
+        f"map: in the window {x} {lo1:g}..{hi1:g}{unit}, {y} {lo2:g}..{hi2:g}{unit}: "
+        f"{len(found.folds)} fold points on {rec['fold_curves']} pieces, "
+        f"{len(found.cusps)} cusps; {spread}"
     )
+    if "unexplained_changes" in rec:
+        print(
+            f"stable-count changes between grid neighbours: {rec['count_changes']}, "
+            f"{rec['unexplained_changes']} not explained by a fold curve or cable switch"
+        )
     print(_files_line(folder))
     print(f"the 2-D sweep behind regions.csv: {folder / SWEEP_FOLDER} (sweep.csv, points.bin)")
-    return EXIT_OK if found.record["sweep_status"] == "ok" else EXIT_INCOMPLETE
+    if rec.get("unexplained_changes"):
+        _warn([f"{rec['unexplained_changes']} stable-count changes unexplained (run.json)"])
+    return EXIT_OK if found.status == "ok" else EXIT_INCOMPLETE
 
 
 def design(args: argparse.Namespace) -> int:

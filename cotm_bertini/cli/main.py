@@ -122,15 +122,21 @@ def _barriers_parser(sub) -> None:
 
 
 def _map_parser(sub) -> None:
-    m = sub.add_parser("map", help="stable-count regions and fold curves over (L01, L02)")
+    m = sub.add_parser(
+        "map",
+        help="stable-count regions and fold curves over two parameters",
+        description="The paper's mechanism over (L01, L02), default 0 to 14 m on both axes; "
+        "or a framework (--framework FILE.toml) over any two of its parameters (--param, "
+        "--param2 and their ranges required).",
+    )
     add_params(m)
     add_settings(m)
-    m.add_argument("--param", default="L01", help="first axis: L01 or L02 (default L01)")
-    m.add_argument("--from", dest="start", type=float, default=0.0, help="default 0")
-    m.add_argument("--to", dest="stop", type=float, default=14.0, help="default 14")
-    m.add_argument("--param2", default="L02", help="second axis (default L02)")
-    m.add_argument("--from2", dest="start2", type=float, default=0.0, help="default 0")
-    m.add_argument("--to2", dest="stop2", type=float, default=14.0, help="default 14")
+    m.add_argument("--param", help="first axis (default L01; a framework: one of its parameters)")
+    m.add_argument("--from", dest="start", type=float, help="default 0 (the paper)")
+    m.add_argument("--to", dest="stop", type=float, help="default 14 (the paper)")
+    m.add_argument("--param2", help="second axis (default L02)")
+    m.add_argument("--from2", dest="start2", type=float, help="default 0 (the paper)")
+    m.add_argument("--to2", dest="stop2", type=float, help="default 14 (the paper)")
     m.add_argument("--points", type=int, default=101, help="grid points a side (default 101)")
     m.add_argument("--workers", type=int, help="local processes (default: one per core)")
     m.add_argument("--out", metavar="DIR", default="runs/map", help="default runs/map")

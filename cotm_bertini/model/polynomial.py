@@ -89,8 +89,18 @@ class ParametricSystem:
         return tuple(np.unique(ve, axis=0, return_inverse=True) for ve in self.var_exps)
 
     def instantiate(self, values: Sequence[complex]) -> PolySystem:
-        """The numeric system at parameter values (same order as `parameters`)."""
+        """The numeric system at parameter values (same order as `parameters`); the last few
+        are kept (a sweep's point asks for its system to solve it, then to classify it)."""
         p = np.asarray(values)
+        key = (p.dtype.str, p.tobytes())
+        recent = self.__dict__.setdefault("_recent", {})
+        if key not in recent:
+            if len(recent) >= 4:
+                del recent[next(iter(recent))]
+            recent[key] = self._instantiate(p)
+        return recent[key]
+
+    def _instantiate(self, p: np.ndarray) -> PolySystem:
         exps, cfs = [], []
         for (uniq, inverse), pe, c in zip(self._monomials, self.par_exps, self.coeffs, strict=True):
             term = c * np.prod(p[None, :] ** pe, axis=1)

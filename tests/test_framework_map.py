@@ -1,0 +1,159 @@
+"""Design maps of frameworks (issue 19): `cb.design_map(fw, x, (..), y, (..))` and `map
+--framework`. The stable counts of the grid are checked against a dense scan of Zeeman's energy
+(tests/framework_physics.py: no package code); the completeness check (every change of the
+stable count between grid neighbours crossed by a fold curve that changes it, or a cable
+switch) is checked on curves drawn by hand, then run on the Zeeman maps."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+from conftest import run_cli
+from framework_physics import zeeman_energy
+
+import cotm_bertini as cb
+from cotm_bertini.analysis.region_changes import count_changes, unexplained
+from cotm_bertini.api.maps import grid_values
+
+EXAMPLES = "examples"
+WINDOW = {"x": (-0.6, 0.8), "y": (-0.8, 0.2)}  # the issue's window: Zeeman's diamond inside
+N = 21  # grid points a side in make test
+
+
+# ---- the completeness check itself, on hand-made regions and curves -------------------------
+
+
+def _disc(n: int = 21, r: float = 0.3) -> pd.DataFrame:
+    xs = np.linspace(0, 1, n)
+    gx, gy = np.meshgrid(xs, xs, indexing="ij")
+    inside = np.hypot(gx - 0.5, gy - 0.5) < r
+    return pd.DataFrame(
+        {"a": gx.ravel(), "b": gy.ravel(), "physical": 3, "stable": 1 + inside.ravel()}
+    )
+
+
+def _circle(r: float = 0.3, centre=(0.5, 0.5), points: int = 400, **cols) -> pd.DataFrame:
+    t = np.linspace(0, 2 * np.pi, points)
+    return pd.DataFrame(
+        {"a": centre[0] + r * np.cos(t), "b": centre[1] + r * np.sin(t), "curve_id": 0,
+         "arc": t, "kind": "fold", "physical": True, "changes_stable_count": True, **cols}
+    )  # fmt: skip
+
+
+def test_the_check_accepts_a_boundary_crossed_by_its_curve():
+    regions, folds = _disc(), _circle()
+    assert len(count_changes(regions, "a", "b")) > 20
+    missed, tol = unexplained(regions, folds, "a", "b")
+    assert missed.empty and 0 < tol < 0.01
+    # A cable switch explains a change whatever its changes_stable_count.
+    switch = folds.assign(kind="cable_switch", changes_stable_count=False)
+    assert unexplained(regions, switch, "a", "b")[0].empty
+
+
+def test_the_check_finds_changes_no_curve_explains():
+    regions, folds = _disc(), _circle()
+    upper = folds.b > 0.5
+    silent = folds.assign(changes_stable_count=~upper)  # the upper half: folds of no consequence
+    missed, _ = unexplained(regions, silent, "a", "b")
+    assert len(missed) > 5 and (missed[["y0", "y1"]].min(axis=1) >= 0.5).all()
+    # A curve cut into two pieces where it leaves a gap: the gap is not bridged.
+    gap = folds[(folds.arc < 1.0) | (folds.arc > 2.0)]
+    assert not unexplained(regions, gap, "a", "b")[0].empty
+    # The same circle displaced by a grid step: the changes it no longer crosses are found.
+    shifted = _circle(centre=(0.55, 0.5))
+    assert not unexplained(regions, shifted, "a", "b")[0].empty
+
+
+# ---- Zeeman's machine: the map's regions against a scan of V --------------------------------
+
+
+def _scan_counts(x: float, y: float, cables: bool, n: int = 20_000) -> tuple[int, int]:
+    """(critical points, minima) of V on the circle of wheel angles, by sign changes of dV on a
+    dense grid (independent of the package)."""
+    t = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    v = zeeman_energy(t, (x, y), cables)
+    dv = np.roll(v, -1) - v
+    change = np.sign(dv) != np.sign(np.roll(dv, -1))
+    minima = change & (dv < 0)
+    return int(change.sum()), int(minima.sum())
+
+
+@pytest.fixture(scope="module")
+def zeeman_map():
+    fw = cb.Framework.from_toml(f"{EXAMPLES}/zeeman.toml")
+    return cb.design_map(fw, "x", WINDOW["x"], "y", WINDOW["y"], points=N, workers=2)
+
+
+def test_zeeman_regions_match_a_scan_of_the_energy(zeeman_map):
+    regions = zeeman_map.regions
+    assert list(regions.columns) == ["x", "y", "physical", "stable"]
+    assert np.array_equal(np.unique(regions.x), grid_values(*WINDOW["x"], N))
+    for _, r in regions.iterrows():
+        critical, minima = _scan_counts(r.x, r.y, cables=False)
+        assert (r.physical, r.stable) == (critical, minima), (r.x, r.y)
+    assert set(regions.stable) == {1, 2}  # the diamond is bistable, the rest not
+
+
+def test_zeeman_map_count_changes_are_explained(zeeman_map):
+    rec = zeeman_map.record
+    assert rec["count_changes"] > 10
+    assert rec["unexplained_changes"] == 0, rec["unexplained"]
+    assert rec["status"] == "ok" and zeeman_map.status == "ok"
+    missed, _ = unexplained(zeeman_map.regions, zeeman_map.folds, "x", "y")
+    assert missed.empty
+
+
+def test_zeeman_map_cusps_and_folds(zeeman_map):
+    folds = zeeman_map.folds
+    assert folds.physical.all()
+    assert folds.x.between(*WINDOW["x"]).all() and folds.y.between(*WINDOW["y"]).all()
+    assert zeeman_map.cusps.kind.eq("cusp").all()
+    assert len(zeeman_map.cusps) == zeeman_map.record["cusps"]
+
+
+# ---- the command line ---------------------------------------------------------------------
+
+ZEEMAN_ARGS = ("map", "--framework", f"{EXAMPLES}/zeeman.toml", "--quiet")
+
+
+@pytest.mark.parametrize(
+    ("args", "named"),
+    [
+        (("--param", "z", "--from", "0", "--to", "1", "--param2", "y", "--from2", "0",
+          "--to2", "1"), "--param 'z'"),
+        (("--param", "x", "--from", "0", "--to", "1", "--param2", "y", "--from2", "0"),
+         "--to2 is required"),
+        (("--param", "x", "--from", "0", "--to", "1"), "--param2 is required"),
+        (("--param", "x", "--from", "1", "--to", "0", "--param2", "y", "--from2", "0",
+          "--to2", "1"), "x: the range 1 to 0 is empty"),
+    ],
+)  # fmt: skip
+def test_map_framework_refuses_bad_input_in_one_line(tmp_path, args, named):
+    run = run_cli(*ZEEMAN_ARGS, *args, "--out", str(tmp_path / "m"))
+    assert run.returncode == 2, run.stderr
+    assert run.stderr.count("\n") == 1 and named in run.stderr, run.stderr
+    assert not (tmp_path / "m").exists() or not any((tmp_path / "m").iterdir())
+
+
+def test_map_framework_writes_the_map(tmp_path):
+    window = ("--param", "x", "--from", "-0.6", "--to", "0.8",
+              "--param2", "y", "--from2", "-0.8", "--to2", "0.2", "--points", "7")  # fmt: skip
+    run = run_cli(*ZEEMAN_ARGS, *window, "--workers", "1", "--out", str(tmp_path))
+    assert run.returncode == 0, run.stderr
+    folder = (tmp_path / "latest").resolve()
+    regions = pd.read_csv(folder / "regions.csv")
+    assert list(regions.columns) == ["x", "y", "physical", "stable"] and len(regions) == 49
+    folds = pd.read_csv(folder / "folds.csv")
+    for col in ("x", "y", "wheel.angle_deg", "curve_id", "arc", "kind", "changes_stable_count"):
+        assert col in folds.columns
+    rec = json.loads((folder / "run.json").read_text())
+    assert rec["window"] == {"x": [-0.6, 0.8], "y": [-0.8, 0.2]} and rec["points"] == 7
+    assert rec["framework"] == "zeeman" and rec["unexplained_changes"] == 0
+    assert {"folds", "regions"} <= set(rec["timings"]) and rec["fold_record"]
+    assert (folder / "map.png").is_file() and (folder / "sweep" / "sweep.csv").is_file()
+    line = next(ln for ln in run.stdout.splitlines() if ln.startswith("map:"))
+    assert "in the window x -0.6..0.8, y -0.8..0.2" in line
+    assert f"{len(folds)} fold points" in line

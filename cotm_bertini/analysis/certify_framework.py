@@ -21,6 +21,7 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
+from flint import arb
 
 from ..model.framework.ballcode import ball_module
 from ..model.framework.compiled import FrameworkSystem, framework_system, variable_scale
@@ -75,9 +76,8 @@ def _evaluate(e, values: dict, number):
 
 
 def _ball(v):
-    from flint import arb
-
-    return v if isinstance(v, arb) else arb(v)
+    """A generated function's entry as a ball (its constant entries are plain floats)."""
+    return v if type(v) is arb else arb(v)
 
 
 @dataclass
@@ -238,15 +238,21 @@ def torus_landscape(fw: Framework, fs: FrameworkSystem, P: list) -> Landscape:
             X[s], X[c] = a.sin_cos()
         return X
 
-    def parts(balls) -> list:
-        first, per = code.first_order(pose(balls), P), dim + dim * m
+    memo: dict = {}  # the last box's first-order parts and gradient: the search asks twice
+
+    def parts(balls) -> tuple:
+        if memo.get("balls") is balls:  # the same tuple (kept alive here: its id is unique)
+            return memo["parts"]
+        first, per = [_ball(v) for v in code.first_order(pose(balls), P)], dim + dim * m
         out = []
         for i, (k, L0) in enumerate(links):
             r, dr = first[i * per : i * per + dim], first[i * per + dim : (i + 1) * per]
-            dd = sum((_ball(c) * c for c in r[1:]), _ball(r[0]) * r[0])
-            a = [sum(_ball(r[c]) * dr[c * m + j] for c in range(dim)) for j in range(m)]
+            dd = sum((c * c for c in r[1:]), r[0] * r[0])
+            a = [sum((r[c] * dr[c * m + j] for c in range(1, dim)), r[0] * dr[j])
+                 for j in range(m)]  # fmt: skip
             out.append((k, L0, dd, a))
-        return out, first[len(links) * per :]
+        memo.update(balls=balls, parts=(out, first[len(links) * per :]))
+        return memo["parts"]
 
     def enclose(balls, hessian: bool = True):
         springs, loads = parts(balls)

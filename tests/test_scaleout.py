@@ -240,3 +240,14 @@ def test_unreachable_scheduler_is_one_line_exit_2_nothing_written(tmp_path, monk
     assert not list(cache.glob("**/generic-*.json")) and not list(cache.glob("solves/*"))
     with pytest.raises(cb.ParameterError, match="scheduler = 'tcp://h:1': .* engine='homotopy'"):
         cb.Settings(engine="cli", scheduler="tcp://h:1")
+
+
+@pytest.mark.slow
+def test_double_pendulum_generic_set_split_equals_bertinis(scheduler):
+    """128 paths by each route (about 40 s each on a quiet machine): `make stress`."""
+    fw = cb.Framework.from_toml(ROOT / "examples" / "double_pendulum.toml")
+    fs = framework_system(fw, taut_sets(fw)[0])
+    kw = {"use_cache": False, "centre": _centre(fw, fs), "groups": variable_groups(fs)}
+    own = homotopy.generic_set(fs.ps, 1, scheduler=scheduler, **kw)
+    assert_same_generic_set(own, homotopy.generic_set(fs.ps, 1, **kw))
+    assert own.paths == 128 and own.route["failed_paths"] == 0

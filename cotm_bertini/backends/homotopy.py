@@ -284,47 +284,59 @@ def _split_solve(system, seed: int, groups, scheduler: str) -> tuple[tuple, dict
     lp = linear_product_start(system, groups, seed)
     gamma = np.exp(2j * np.pi * np.random.default_rng((seed, 1)).random())
     texts = (gamma_homotopy_text(system, lp, gamma), render_system(system))
-    total = lp.count()
-    counts: dict[str, int] = {}
+    total, starts, workers = lp.count(), [], []
 
-    def jobs(workers: int) -> list[dict]:
-        counts["workers"] = workers
-        size = max(1, -(-total // (CHUNKS_PER_WORKER * workers)))
-        return [{"texts": texts, "points": c} for c in lp.chunks(size)]
+    def jobs(n: int) -> list[dict]:
+        workers.append(n)
+        starts.extend(lp.chunks(max(1, -(-total // (CHUNKS_PER_WORKER * n)))))
+        return [{"texts": texts, "points": c} for c in starts]
 
     done = dict(run_jobs(track_chunk, jobs, scheduler))
     chunks = [done[k] for k in range(len(done))]
+    ends = [[x for c in chunks for x in c[f]] for f in ("codes", "finite", "singular")]
     pts = np.vstack([c["points"] for c in chunks])
-    codes = [code for c in chunks for code in c["codes"]]
-    finite = [f for c in chunks for f in c["finite"]]
-    singular = [s for c in chunks for s in c["singular"]]
-    _mark_coincident(codes, finite, singular, pts)
-    failed = sum(c != _SUCCESS and c not in INFINITE_CODES for c in codes)
+    twins = _twins(*ends, pts)
+    if twins:  # one path jumped onto another's root in double precision: both again, in AMP
+        job = {"texts": texts, "points": np.vstack(starts)[twins], "mptype": "adaptive"}
+        again = next(iter(run_jobs(track_chunk, [job], scheduler)))[1]
+        for k, i in enumerate(twins):
+            for f, col in zip(("codes", "finite", "singular"), ends, strict=True):
+                col[i] = again[f][k]
+            pts[i] = again["points"][k]
+        for i in _twins(*ends, pts):  # still together: a multiple root, as ZeroDimSolver says
+            ends[2][i] = True
     route = {
         "method": f"own {'multihomogeneous' if groups else 'total-degree'} linear-product "
         f"start, split in {len(chunks)} chunks on {scheduler}",
         "scheduler": scheduler,
-        "workers": counts["workers"],
+        "workers": workers[0],
         "chunks": len(chunks),
         "paths_per_chunk": [len(c["codes"]) for c in chunks],
         "chunk_seconds": [round(c["seconds"], 3) for c in chunks],
-        "failed_paths": failed,
+        "retracked_adaptive": sum(c["retracked_adaptive"] for c in chunks) + len(twins),
+        "failed_paths": sum(c != _SUCCESS and c not in INFINITE_CODES for c in ends[0]),
     }
-    return (codes, finite, singular, pts), route
+    return (*ends, pts), route
 
 
-def _mark_coincident(codes: list, finite: list, singular: list, pts: np.ndarray) -> None:
-    """Nonsingular endpoints of different chunks at the same point: a multiple root (as
-    ZeroDimSolver marks multiplicity > 1 over all its paths), so singular."""
+def _twins(codes: list, finite: list, singular: list, pts: np.ndarray) -> list[int]:
+    """The nonsingular finite endpoints that coincide with another one (relative 1e-7)."""
     idx = [i for i, c in enumerate(codes) if c == _SUCCESS and finite[i] and not singular[i]]
-    if len(idx) < 2:
-        return
-    p = pts[idx]
-    scale = 1.0 + np.abs(p).max(axis=1)
-    for a in range(len(idx)):
-        d = np.abs(p[a + 1 :] - p[a]).max(axis=1) / np.maximum(scale[a + 1 :], scale[a])
-        for b in np.nonzero(d < 1e-7)[0]:
-            singular[idx[a]] = singular[idx[a + 1 + b]] = True
+    return [idx[k] for k in sorted(coincident_rows(pts[idx]))]
+
+
+def coincident_rows(pts: np.ndarray, tol: float = 1e-7) -> set[int]:
+    """Rows of `pts` within `tol` (relative to 1 + the larger norm) of another row."""
+    out: set[int] = set()
+    if len(pts) < 2:
+        return out
+    scale = 1.0 + np.abs(pts).max(axis=1)
+    for a in range(len(pts)):
+        d = np.abs(pts[a + 1 :] - pts[a]).max(axis=1) / np.maximum(scale[a + 1 :], scale[a])
+        near = np.nonzero(d < tol)[0]
+        if len(near):
+            out.update([a, *(a + 1 + near).tolist()])
+    return out
 
 
 def _end_points(pts, n: int) -> np.ndarray:
@@ -336,26 +348,56 @@ def _end_points(pts, n: int) -> np.ndarray:
     return out
 
 
-def track_chunk(job: dict) -> dict:
-    """One chunk of a split generic solve (a Dask task: plain data in, plain data out): the
-    gamma-trick homotopy `job["texts"]` tracked from `job["points"]` in adaptive precision."""
+def _track_texts(texts: tuple[str, str], points: np.ndarray, mptype: str) -> dict:
+    """The homotopy texts[0] (target texts[1]) tracked from `points` on one thread (the
+    parallelism is the cluster's), with the step caps of track and the generic solve."""
     bertini = _bertini()
     from bertini import nag_algorithm as na
 
-    t0 = time.perf_counter()
-    hom, target = (bertini.parse.system(text) for text in job["texts"])
-    solver = na.HomotopySolver(hom, list(job["points"]), target, mptype="adaptive")
-    # One thread a chunk: the parallelism is the cluster's (as for a sweep's points).
-    solver.set(max_num_steps=GENERIC_MAX_STEPS, num_threads=1)
+    hom, target = (bertini.parse.system(text) for text in texts)
+    solver = na.HomotopySolver(hom, list(points), target, mptype=mptype)
+    if mptype == "double":  # as in track: give up early, adaptive precision redoes it
+        solver.set(final_tolerance=DOUBLE_FINAL_TOLERANCE, max_num_steps=DOUBLE_MAX_STEPS)
+    else:
+        solver.set(max_num_steps=GENERIC_MAX_STEPS)
+    solver.set(num_threads=1)
     solver.solve(show_progress=False)
     meta, pts = solver.solution_metadata(), solver.all_solutions()
     return {
         "codes": [_code(m) for m in meta],
         "finite": [bool(m.is_finite) for m in meta],
         "singular": [is_singular(m) for m in meta],
-        "points": _end_points(pts, len(job["points"][0])),
-        "seconds": time.perf_counter() - t0,
+        "points": _end_points(pts, points.shape[1]),
     }
+
+
+def track_chunk(job: dict) -> dict:
+    """One chunk of a split generic solve (a Dask task: plain data in, plain data out): the
+    gamma-trick homotopy `job["texts"]` tracked from `job["points"]` in double precision, and
+    every path that does not end at a nonsingular finite point (or that meets another) again
+    in adaptive precision, as `track` does (`job["mptype"] = "adaptive"`: all in AMP)."""
+    t0 = time.perf_counter()
+    points = np.asarray(job["points"], dtype=complex)
+    if job.get("mptype") == "adaptive":
+        out, redo = _track_texts(job["texts"], points, "adaptive"), []
+    else:
+        out = _track_texts(job["texts"], points, "double")
+        fields = [out[f] for f in ("codes", "finite", "singular")]
+        redo = sorted(
+            {
+                k
+                for k, (c, f, s) in enumerate(zip(*fields, strict=True))
+                if c != _SUCCESS or not f or s
+            }
+            | set(_twins(*fields, out["points"]))
+        )
+    if redo:
+        again = _track_texts(job["texts"], points[redo], "adaptive")
+        for f in ("codes", "finite", "singular"):
+            for k, i in enumerate(redo):
+                out[f][i] = again[f][k]
+        out["points"][redo] = again["points"]
+    return {**out, "retracked_adaptive": len(redo), "seconds": time.perf_counter() - t0}
 
 
 def route_record(sets: list[GenericSet], scheduler: str | None) -> dict:
@@ -524,14 +566,7 @@ def _crossing(results: dict, idx: list[int], tol: float = 1e-7) -> bool:
         [[complex(z) for z in results[i][1]] for i in idx if not is_singular(results[i][0])],
         dtype=complex,
     )
-    if len(pts) < 2:
-        return False
-    scale = 1.0 + np.abs(pts).max(axis=1)
-    for a in range(len(pts)):
-        d = np.abs(pts[a + 1 :] - pts[a]).max(axis=1) / np.maximum(scale[a + 1 :], scale[a])
-        if (d < tol).any():
-            return True
-    return False
+    return bool(coincident_rows(pts, tol))
 
 
 def zero_length_roots(params: Params, variables: tuple[str, ...]) -> Endpoints:

@@ -156,10 +156,10 @@ def same_sets(a: np.ndarray, b: np.ndarray, tol: float = 1e-8) -> bool:
     return True
 
 
-def assert_same_generic_set(own, theirs) -> None:
+def assert_same_generic_set(own, theirs, start: str = "multihomogeneous") -> None:
     """Two routes to one generic set: same key, path count, finite, singular, nonsingular set."""
-    assert own.route["method"].startswith("own multihomogeneous")
-    assert theirs.route["method"].startswith("bertini multihomogeneous")
+    assert own.route["method"].startswith(f"own {start}")
+    assert theirs.route["method"].startswith(f"bertini {start}")
     assert own.key == theirs.key and own.paths == theirs.paths
     assert (own.finite_endpoints, own.singular_endpoints) == (
         theirs.finite_endpoints,
@@ -251,3 +251,16 @@ def test_double_pendulum_generic_set_split_equals_bertinis(scheduler):
     own = homotopy.generic_set(fs.ps, 1, scheduler=scheduler, **kw)
     assert_same_generic_set(own, homotopy.generic_set(fs.ps, 1, **kw))
     assert own.paths == 128 and own.route["failed_paths"] == 0
+
+
+@pytest.mark.slow
+def test_paper_generic_set_split_equals_bertinis(scheduler):
+    """The built-in mechanism (one group: a total-degree count, 192 paths, 16 singular ends at
+    the d = 0 artefacts) by both routes: `make stress`."""
+    from cotm_bertini.model.compiled import parametric_system
+
+    ps = parametric_system((False, False))
+    own = homotopy.generic_set(ps, 1, use_cache=False, scheduler=scheduler)
+    theirs = homotopy.generic_set(ps, 1, use_cache=False)
+    assert_same_generic_set(own, theirs, "total-degree")
+    assert own.paths == 192 and own.singular_endpoints > 0

@@ -28,6 +28,12 @@ def zeeman():
     return cb.solve(cb.Framework.from_toml(EXAMPLES / "zeeman.toml").replace(x=0.1, y=-0.25))
 
 
+@pytest.fixture(scope="module")
+def certified(pendulum, zeeman):
+    """Each solve certified once (cb.certify attaches the certificate to the solve)."""
+    return {"pendulum": cb.certify(pendulum), "zeeman": cb.certify(zeeman)}
+
+
 def _table_kinds(phys) -> dict[int, str]:
     return {int(s): str(k) for s, k in zip(phys["solution_id"], phys["kind"], strict=True)}
 
@@ -38,9 +44,8 @@ def _real_nonsingular(res) -> np.ndarray:
 
 
 @pytest.mark.parametrize("name", ["zeeman", "pendulum"])
-def test_circle_and_torus_frameworks_are_proved_complete(name, request):
-    res = request.getfixturevalue(name)
-    cert = cb.certify(res)
+def test_circle_and_torus_frameworks_are_proved_complete(name, request, certified):
+    res, cert = request.getfixturevalue(name), certified[name]
     assert cert.status == "proved", cert.statement
     assert cert.method == "framework-torus"
     real = _real_nonsingular(res)
@@ -53,13 +58,13 @@ def test_circle_and_torus_frameworks_are_proved_complete(name, request):
     assert res.table["certified"].dtype == bool
 
 
-def _newton_from_grid(f, n: int = 120, h: float = 1e-5) -> list[tuple[np.ndarray, str]]:
+def _newton_from_grid(f, n: int = 90, h: float = 1e-5) -> list[tuple[np.ndarray, str]]:
     """Every critical point of f on the torus that Newton on central differences reaches from
     an n x n grid, with its kind from the Hessian's eigenvalues (no package code)."""
     t = np.linspace(0, 2 * np.pi, n, endpoint=False)
     x = np.stack([a.ravel() for a in np.meshgrid(t, t, indexing="ij")], axis=1)
     e = np.eye(2) * h
-    for _ in range(60):
+    for _ in range(40):
         g = np.stack([(f(*(x + e[k]).T) - f(*(x - e[k]).T)) / (2 * h) for k in (0, 1)], axis=1)
         H = np.empty((len(x), 2, 2))
         for a in (0, 1):
@@ -83,8 +88,8 @@ def _newton_from_grid(f, n: int = 120, h: float = 1e-5) -> list[tuple[np.ndarray
     return found
 
 
-def test_pendulum_count_agrees_with_an_independent_dense_search(pendulum):
-    cert = cb.certify(pendulum)
+def test_pendulum_count_agrees_with_an_independent_dense_search(pendulum, certified):
+    cert = certified["pendulum"]
     found = _newton_from_grid(pendulum_energy)
     kinds = sorted(k for _, k in found)
     assert cert.proved_equilibria == len(found), (cert.statement, found)
@@ -97,8 +102,8 @@ def test_pendulum_count_agrees_with_an_independent_dense_search(pendulum):
         assert np.abs((poses - p + np.pi) % (2 * np.pi) - np.pi).max(axis=1).min() < 1e-5
 
 
-def test_zeeman_count_agrees_with_a_dense_scan(zeeman):
-    cert = cb.certify(zeeman)
+def test_zeeman_count_agrees_with_a_dense_scan(certified):
+    cert = certified["zeeman"]
     crit = scan_critical_points(lambda t: zeeman_energy(t, (0.1, -0.25), False))
     assert cert.proved_equilibria == len(crit)
     assert sorted(cert.kinds.values()) == sorted(k for _, k in crit)

@@ -165,3 +165,14 @@ def test_a_framework_sweep_certifies_every_point(tmp_path):
     real = table["is_real"].astype(bool) & ~table["singular"].astype(bool)
     assert table.loc[real, "certified"].astype(bool).all()
     assert not table.loc[~real, "certified"].astype(bool).any()
+
+
+@pytest.mark.parametrize("u", [(0.1, -0.25), (1.45, 0.2)])
+def test_zeeman_with_cables_is_proved_complete(u):
+    # The solves of tests/test_frameworks.py (a slack band at (1.45, 0.2)): V is piecewise.
+    fw = cb.Framework.from_toml(EXAMPLES / "zeeman_cables.toml").replace(x=u[0], y=u[1])
+    cert = cb.certify(cb.solve(fw))
+    assert cert.status == "proved", cert.statement
+    crit = scan_critical_points(lambda t: zeeman_energy(t, u, True))
+    assert cert.proved_equilibria == len(crit)
+    assert sorted(cert.kinds.values()) == sorted(k for _, k in crit)

@@ -14,7 +14,7 @@ def certify(res: Solutions, strict: bool = True):
 
     A framework (cb.Framework): every real row proved on its taut set's system, with its
     consistency and kind; completeness by branch and bound where its poses form a circle or a
-    torus and no cable makes V piecewise; elsewhere the status is 'rows proved' and the
+    torus (cables included); elsewhere the status is 'rows proved' and the
     statement says completeness is not proved (docs/certify.md, "Frameworks").
 
     Returns the Certificate and attaches it to `res` (`res.certificate`; `res.table` gains the

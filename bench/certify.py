@@ -56,7 +56,8 @@ def one(params, label: str, torus: bool) -> dict:
     return row
 
 
-FRAMEWORKS = {"zeeman": {"x": 0.1, "y": -0.25}, "double_pendulum": {}, "cotm": {},
+FRAMEWORKS = {"zeeman": {"x": 0.1, "y": -0.25}, "zeeman_cables": {"x": 1.45, "y": 0.2},
+              "double_pendulum": {}, "cotm": {},
               "fourbar": {}}  # fmt: skip
 
 

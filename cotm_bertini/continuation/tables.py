@@ -35,7 +35,7 @@ def concat_columns(parts: Sequence[Mapping[str, np.ndarray]]) -> Columns:
 
 
 def _quote(text: str) -> str:
-    if any(c in text for c in ',"\r\n'):
+    if "," in text or '"' in text or "\r" in text or "\n" in text:
         return '"' + text.replace('"', '""') + '"'
     return text
 
@@ -59,7 +59,17 @@ def column_text(values: np.ndarray) -> list[str]:
         return out
     if kind in "biu":
         return list(map(str, arr.tolist()))
-    return [_cell(v) for v in arr.tolist()]
+    seen: dict = {}  # a point's rows repeat their method, status, kind and reason
+    out = []
+    for v in arr.tolist():
+        key = (type(v), v) if isinstance(v, str | bool | None) else None
+        if key is None:
+            out.append(_cell(v))
+        else:
+            if key not in seen:
+                seen[key] = _cell(v)
+            out.append(seen[key])
+    return out
 
 
 def csv_text(columns: Mapping[str, Sequence]) -> str:

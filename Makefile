@@ -49,6 +49,7 @@ map: $(STAMP)
 stress: $(STAMP) phcpack
 	COTM_STRESS=full $(BIN)/pytest -q tests/stress tests/test_fold_curves.py \
 	  tests/test_frameworks.py::test_cotm_framework_random_geometries \
+	  tests/test_certify_frameworks.py \
 	  tests/test_scaleout.py::test_double_pendulum_generic_set_split_equals_bertinis \
 	  tests/test_scaleout.py::test_paper_generic_set_split_equals_bertinis
 

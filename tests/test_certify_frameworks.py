@@ -176,3 +176,36 @@ def test_zeeman_with_cables_is_proved_complete(u):
     crit = scan_critical_points(lambda t: zeeman_energy(t, u, True))
     assert cert.proved_equilibria == len(crit)
     assert sorted(cert.kinds.values()) == sorted(k for _, k in crit)
+
+
+@pytest.mark.parametrize(
+    "case, n", [("case1", 4), pytest.param("case3", 14, marks=pytest.mark.slow)]
+)
+def test_cotm_toml_is_proved_with_the_papers_count(case, n):
+    # The paper's mechanism as a framework (solved in tests/test_frameworks.py too): the paper
+    # lists 4 physical equilibria in case 1 and 14 in case 3.
+    p = cb.Params.case(case)
+    fw = cb.Framework.from_toml(EXAMPLES / "cotm.toml").replace(L01=p.L01, L02=p.L02)
+    cert = cb.certify(cb.solve(fw))
+    assert cert.status == "proved", cert.statement
+    assert cert.proved_equilibria == n
+
+
+@pytest.mark.slow
+def test_prism_rows_proved_completeness_not_claimed():
+    res = cb.solve(cb.Framework.from_toml(EXAMPLES / "prism.toml"))
+    cert = cb.certify(res)
+    assert cert.status == "rows proved", cert.statement
+    assert cert.certified[_real_nonsingular(res)].all()
+    assert cert.kinds == _table_kinds(res.physical)
+
+
+def test_a_cached_solve_is_certified_alike(zeeman, certified):
+    # Answered from the cache: the table is read back from solutions.csv (an empty taut_set
+    # field comes back as NaN), and must be proved the same.
+    again = cb.solve(zeeman.params)
+    assert again.cache_hit
+    cert = cb.certify(again)
+    assert cert.status == "proved", cert.statement
+    assert (cert.certified == certified["zeeman"].certified).all()
+    assert cert.kinds == certified["zeeman"].kinds

@@ -137,7 +137,8 @@ def certify_rows(fw: Framework, table, P: list, exact: list) -> _Rows:
     out = _Rows(np.zeros(n, dtype=bool), np.full(n, np.nan))
     real = np.asarray(table["is_real"], dtype=bool)
     singular = np.asarray(table["singular"], dtype=bool)
-    sets = np.asarray(table["taut_set"], dtype=object)
+    # A table read back from solutions.csv has NaN where no cable is taut (an empty field).
+    sets = np.array([v if isinstance(v, str) else "" for v in table["taut_set"]], dtype=object)
     for label in sorted(set(sets)):
         rows = np.flatnonzero((sets == label) & real & ~singular)
         if not len(rows):

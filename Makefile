@@ -50,8 +50,10 @@ stress: $(STAMP) phcpack
 	COTM_STRESS=full $(BIN)/pytest -q tests/stress tests/test_fold_curves.py \
 	  tests/test_frameworks.py::test_cotm_framework_random_geometries \
 	  tests/test_certify_frameworks.py \
+	  tests/test_barriers_frameworks.py::test_spatial_top_barrier_against_the_closed_form \
 	  tests/test_scaleout.py::test_double_pendulum_generic_set_split_equals_bertinis \
-	  tests/test_scaleout.py::test_paper_generic_set_split_equals_bertinis
+	  tests/test_scaleout.py::test_paper_generic_set_split_equals_bertinis \
+	  tests/test_framework_map.py::test_map_count_changes_are_explained_stress
 
 bench: $(STAMP) phcpack
 	$(BIN)/python bench/run_all.py

@@ -1,6 +1,7 @@
 """Frameworks (issue 18): each example's first solve (generic sets from scratch, in a fresh
 cache) and a later one, paths, and the paper's mechanism from cotm.toml against the built-in
-model. Usage: python bench/frameworks.py [--skip NAME ...] (the prism takes minutes)."""
+model, and the barriers of each solve (cb.barriers, issue 19). Usage: python
+bench/frameworks.py [--skip NAME ...] (the prism takes minutes)."""
 
 from __future__ import annotations
 
@@ -46,10 +47,15 @@ def _row(name: str, env: dict) -> dict:
     sets = dict(a.split("=") for a in EXAMPLES[name][1::2])
     res = cb.solve(fw.replace(**{k: float(v) for k, v in sets.items()}))
     c = res.counts
+    t0 = time.perf_counter()
+    found = cb.barriers(res)  # every index-1 saddle's two descents (issue 19)
+    barriers_s = time.perf_counter() - t0
     return {"example": name, "first_solve_s": first, "later_solve_s": later,
             "generic_paths": c["generic_paths"], "paths_tracked": c["paths_tracked"],
             "physical": c["physical"], "stable": c["stable"], "status": res.status,
-            "morse": res.morse.get("manifold", "n/a")}  # fmt: skip
+            "morse": res.morse.get("manifold", "n/a"), "barriers_s": barriers_s,
+            "saddles": len(found.table), "pairs_joined": len(found.pairs),
+            "barrier_warnings": len(found.warnings)}  # fmt: skip
 
 
 def main() -> None:
@@ -61,7 +67,8 @@ def main() -> None:
     rows = [_row(n, env) for n in EXAMPLES if n not in opts.skip]
     builtin = min(_run(["solve", "case3"], env) for _ in range(3))
     frame = pd.DataFrame(rows)
-    show("frameworks: CLI solve, end to end (s)", frame, {"first_solve_s": ".1f"})
+    show("frameworks: CLI solve, end to end (s); cb.barriers of the solve (s)", frame,
+         {"first_solve_s": ".1f", "barriers_s": ".2f"})  # fmt: skip
     print(f"\nbuilt-in `solve case3` (same run, cached generic set): {builtin:.2f} s; "
           f"cotm.toml later solve / built-in: "
           f"{frame.set_index('example').loc['cotm', 'later_solve_s'] / builtin:.1f}x"

@@ -256,15 +256,6 @@ def _failure_record(folder, params, settings, label, exc, seconds) -> None:
     )
 
 
-def paper_only(res: Solutions, what: str) -> None:
-    """Refuse, in one line, an analysis that covers the paper's mechanism only (so far)."""
-    if not isinstance(res.params, Params):
-        raise ParameterError(
-            f"{what}: covers the paper's mechanism only so far, not framework "
-            f"{res.params.name!r} (frameworks: solve and sweep)"
-        )
-
-
 def by_solution_id(frame):
     """A solutions table indexed by its solution_id column (the column stays), so labels shown
     and `.loc` agree with the ids that other tables and messages use."""

@@ -1,8 +1,9 @@
 """Scale-out (issue 18): one framework's first generic solve (seed 1, its first taut set) by
 Bertini's own start system in one call, and split in chunks over a Dask LocalCluster of 1 and
-2 worker processes (our own linear-product start system); times, paths per second, counts, and
-whether the sets agree. Usage: python bench/scaleout.py [--example prism] [--workers 1 2]
-(the prism takes minutes; the load average is printed: on a shared machine times are inflated).
+2 worker processes (our own linear-product start system); wall and CPU times (the CPU time does
+not depend much on how loaded the machine is), paths per second, counts, and whether the sets
+agree. Usage: python bench/scaleout.py [--example prism] [--workers 1 2] (the prism takes
+minutes; the load average is printed: on a shared machine wall times are inflated).
 """
 
 from __future__ import annotations
@@ -51,7 +52,9 @@ def _row(route: str, gs, wall: float, reference) -> dict:
     return {"route": route, "seconds": wall, "paths": gs.paths,
             "paths_per_s": gs.paths / wall, "finite": gs.finite_endpoints,
             "nonsingular": len(gs.points), "singular": gs.singular_endpoints,
+            "cpu_s": gs.route.get("cpu_seconds", float("nan")),
             "chunks": gs.route.get("chunks", 1),
+            "retracked_adaptive": gs.route.get("retracked_adaptive", "-"),
             "same_set_as_bertini": "-" if reference is None else _same(gs.points, reference),
             "load_avg_1min": os.getloadavg()[0]}  # fmt: skip
 
@@ -82,7 +85,9 @@ def main() -> None:
         print(f"{n} worker(s): chunk seconds {gs.route['chunk_seconds']}", file=sys.stderr)
     frame = pd.DataFrame(rows)
     print(f"\n{opts.example}: first generic set (seed 1, first taut set), {os.cpu_count()} cores")
-    show("scale-out: generic solve", frame, {"seconds": ".1f", "paths_per_s": ".2f"})
+    show(
+        "scale-out: generic solve", frame, {"seconds": ".1f", "paths_per_s": ".2f", "cpu_s": ".1f"}
+    )
     write_csv(frame, f"scaleout-{opts.example}")
 
 

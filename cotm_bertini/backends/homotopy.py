@@ -259,6 +259,7 @@ def _bertini_solve(system, seed: int, groups) -> tuple[tuple, dict]:
     from bertini import nag_algorithm as na
 
     bertini.random.set_random_seed(seed)
+    cpu = time.process_time()
     solver = na.ZeroDimSolver(bertini.parse.system(render_system(system, groups)))
     if groups:
         # A framework's start system can send a few paths crawling for ever; a path cut short
@@ -273,7 +274,8 @@ def _bertini_solve(system, seed: int, groups) -> tuple[tuple, dict]:
         _end_points(pts, len(system.variables)),
     )
     start = "multihomogeneous" if groups else "total-degree"
-    return ends, {"method": f"bertini {start} start (ZeroDimSolver), one call"}
+    route = {"method": f"bertini {start} start (ZeroDimSolver), one call"}
+    return ends, {**route, "cpu_seconds": round(time.process_time() - cpu, 3)}
 
 
 def _split_solve(system, seed: int, groups, scheduler: str) -> tuple[tuple, dict]:
@@ -295,10 +297,11 @@ def _split_solve(system, seed: int, groups, scheduler: str) -> tuple[tuple, dict
     chunks = [done[k] for k in range(len(done))]
     ends = [[x for c in chunks for x in c[f]] for f in ("codes", "finite", "singular")]
     pts = np.vstack([c["points"] for c in chunks])
-    twins = _twins(*ends, pts)
+    twins, again_cpu = _twins(*ends, pts), 0.0
     if twins:  # one path jumped onto another's root in double precision: both again, in AMP
         job = {"texts": texts, "points": np.vstack(starts)[twins], "mptype": "adaptive"}
         again = next(iter(run_jobs(track_chunk, [job], scheduler)))[1]
+        again_cpu = again["cpu_seconds"]
         for k, i in enumerate(twins):
             for f, col in zip(("codes", "finite", "singular"), ends, strict=True):
                 col[i] = again[f][k]
@@ -313,6 +316,7 @@ def _split_solve(system, seed: int, groups, scheduler: str) -> tuple[tuple, dict
         "chunks": len(chunks),
         "paths_per_chunk": [len(c["codes"]) for c in chunks],
         "chunk_seconds": [round(c["seconds"], 3) for c in chunks],
+        "cpu_seconds": round(sum(c["cpu_seconds"] for c in chunks) + again_cpu, 3),
         "retracked_adaptive": sum(c["retracked_adaptive"] for c in chunks) + len(twins),
         "failed_paths": sum(c != _SUCCESS and c not in INFINITE_CODES for c in ends[0]),
     }
@@ -376,7 +380,7 @@ def track_chunk(job: dict) -> dict:
     gamma-trick homotopy `job["texts"]` tracked from `job["points"]` in double precision, and
     every path that does not end at a nonsingular finite point (or that meets another) again
     in adaptive precision, as `track` does (`job["mptype"] = "adaptive"`: all in AMP)."""
-    t0 = time.perf_counter()
+    t0, cpu = time.perf_counter(), time.process_time()  # one task at a time a worker process
     points = np.asarray(job["points"], dtype=complex)
     if job.get("mptype") == "adaptive":
         out, redo = _track_texts(job["texts"], points, "adaptive"), []
@@ -397,7 +401,12 @@ def track_chunk(job: dict) -> dict:
             for k, i in enumerate(redo):
                 out[f][i] = again[f][k]
         out["points"][redo] = again["points"]
-    return {**out, "retracked_adaptive": len(redo), "seconds": time.perf_counter() - t0}
+    return {
+        **out,
+        "retracked_adaptive": len(redo),
+        "seconds": time.perf_counter() - t0,
+        "cpu_seconds": time.process_time() - cpu,
+    }
 
 
 def route_record(sets: list[GenericSet], scheduler: str | None) -> dict:

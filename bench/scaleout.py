@@ -77,7 +77,7 @@ def main() -> None:
     rows = [_row("bertini start, one call (all cores)", ref, time.perf_counter() - t0, None)]
     for n in opts.workers:
         with LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                          dashboard_address=None) as cluster:  # fmt: skip
+                          dashboard_address=":0") as cluster:  # fmt: skip
             t0 = time.perf_counter()
             gs = generic_set(ps, 1, scheduler=cluster.scheduler_address, **kw)
             wall = time.perf_counter() - t0

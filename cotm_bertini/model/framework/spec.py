@@ -133,40 +133,32 @@ class Framework:
         """A body's points in its own frame."""
         return dict(dict(self.bodies)[body])
 
+    def slot_expressions(self) -> dict[str, Expr]:
+        """Every number of the equations as the file's expression of the parameters."""
+        out: dict[str, Expr] = {}
+        for name, coords in self.ground:
+            out.update(_named_coords(f"g_{name}", coords))
+        for body, pts in self.bodies:
+            for name, coords in pts:
+                out.update(_named_coords(f"b_{body}_{name}", coords))
+        for link in self.links:
+            if link.kind == "bar":
+                out[f"len_{link.name}"] = link.length
+            else:
+                out[f"k_{link.name}"] = link.k
+                out[f"L0_{link.name}"] = link.L0
+        for load in self.loads:
+            out.update(_named_coords(f"f_{load.name}", load.force))
+        return out
+
     def slots(self) -> dict[str, float]:
         """Every number of the equations, evaluated at the parameter values."""
         vals = self.values
-        out: dict[str, float] = {}
-        for name, coords in self.ground:
-            out.update(_coords(f"g_{name}", coords, vals))
-        for body, pts in self.bodies:
-            for name, coords in pts:
-                out.update(_coords(f"b_{body}_{name}", coords, vals))
-        for link in self.links:
-            if link.kind == "bar":
-                out[f"len_{link.name}"] = link.length.evaluate(vals)
-            else:
-                out[f"k_{link.name}"] = link.k.evaluate(vals)
-                out[f"L0_{link.name}"] = link.L0.evaluate(vals)
-        for load in self.loads:
-            out.update(_coords(f"f_{load.name}", load.force, vals))
-        return out
+        return {n: e.evaluate(vals) for n, e in self.slot_expressions().items()}
 
     def constant_slots(self) -> set[str]:
         """The slots whose expression names no parameter (the same for every parameter value)."""
-        out = set()
-        for name, coords in self.ground:
-            out |= {f"g_{name}_{'xyz'[k]}" for k, e in enumerate(coords) if not e.names()}
-        for body, pts in self.bodies:
-            for name, coords in pts:
-                out |= {f"b_{body}_{name}_{'xyz'[k]}" for k, e in enumerate(coords)
-                        if not e.names()}  # fmt: skip
-        for x in self.links:
-            fields = {"len": x.length} if x.kind == "bar" else {"k": x.k, "L0": x.L0}
-            out |= {f"{f}_{x.name}" for f, e in fields.items() if not e.names()}
-        for load in self.loads:
-            out |= {f"f_{load.name}_{'xyz'[k]}" for k, e in enumerate(load.force) if not e.names()}
-        return out
+        return {n for n, e in self.slot_expressions().items() if not e.names()}
 
     def zero_free_length(self) -> tuple[str, ...]:
         """Springs and cables whose free length is exactly 0 at these values (fewer unknowns)."""
@@ -174,8 +166,8 @@ class Framework:
         return tuple(x.name for x in self.links if x.kind != "bar" and s[f"L0_{x.name}"] == 0)
 
 
-def _coords(prefix: str, coords: tuple[Expr, ...], vals: dict) -> dict[str, float]:
-    return {f"{prefix}_{'xyz'[k]}": e.evaluate(vals) for k, e in enumerate(coords)}
+def _named_coords(prefix: str, coords: tuple[Expr, ...]) -> dict[str, Expr]:
+    return {f"{prefix}_{'xyz'[k]}": e for k, e in enumerate(coords)}
 
 
 def _number(where: str, value: object) -> float:

@@ -1,0 +1,360 @@
+"""Fold curves, cusps and cable switches of any framework over two of its parameters.
+
+For every taut set: the fold system (model/framework/folds.py) is solved once at a random complex
+line of the (x, y) plane by Bertini (a witness set of the fold curve) and brought to real lines
+across the window (vertical and horizontal, the window's edges among them) by parameter homotopy;
+each real fold point found there seeds a pseudo-arclength trace of its curve in (X, v, x, y)
+(continuation/curve_trace.py) to the window's edge or until it closes, and a seed on a curve
+already traced is skipped. Cusps are where the curve's image in the plane turns back (refined by
+bisection on the image's speed along the incoming direction) and are confirmed by the vanishing
+of w . F_XX[v, v] (w, v the left and right null vectors of J_X F: the cubic term of the energy
+along the null direction). Cable switches (a taut cable exactly at its free length L0 > 0) are
+found and traced the same way on the switch system. Every point is classified by the
+framework's own classification (analysis/framework_classify.py) at its (x, y).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from ..analysis.framework_classify import (
+    column_names,
+    framework_columns,
+    local_hessian,
+    reduced_eigh,
+)
+from ..backends.endpoints import Endpoints
+from ..backends.homotopy import generic_set, track
+from ..errors import ParameterError
+from ..model.framework.compiled import framework_system
+from ..model.framework.folds import LINE, CurveSystem, curve_system, parameter_values
+from ..model.framework.spec import Framework
+from ..model.framework.units import normalized_slots, units
+from ..settings import Settings, Tolerances
+from .curve_trace import Traced, Window, newton, trace
+
+SPACING = 0.002  # consecutive points of a curve: at most this fraction of the window diagonal
+LINES = 9  # seed lines in each direction (the window's edges among them)
+HMAX = 0.05  # largest step in (X, v, mx, my), normalised units
+TURN_COS = -0.5  # image segments turning by more than 120 deg: a cusp between them
+CUSP_TOL = 1e-6  # |w . F_XX[v, v]| / |F_XX[v, v]| below this confirms a cusp
+
+
+@dataclass(frozen=True)
+class _Curves:
+    """A curve system's traced curves and what finding them took."""
+
+    cs: CurveSystem
+    traced: list[Traced]
+    window: Window
+    eqs: object  # the traced equations (curve_trace.Equations)
+
+
+def framework_fold_curves(
+    fw: Framework,
+    xname: str,
+    xrange: tuple[float, float],
+    yname: str,
+    yrange: tuple[float, float],
+    settings: Settings | None = None,
+) -> tuple[pd.DataFrame, dict]:
+    """Fold curves, cusps and cable switches of `fw` in the window xrange x yrange of its
+    parameters xname, yname: one row a point (docs/columns.md, "framework folds") and the record
+    for run.json."""
+    settings = settings or Settings()
+    _check(fw, xname, xrange, yname, yrange)
+    from ..point import taut_sets
+
+    t0 = time.perf_counter()
+    centre = fw.replace(**{xname: sum(xrange) / 2, yname: sum(yrange) / 2})
+    frames, record = [], {"taut_sets": {}}
+    next_id = 0
+    for taut in taut_sets(centre):
+        if framework_system(centre, taut).free:
+            continue  # moves freely: no isolated equilibria, so no folds (continuum_check's job)
+        cables = [c for c in taut if normalized_slots(centre)[f"L0_{c}"] != 0]
+        for cable in ["", *cables]:
+            cs = curve_system(centre, taut, xname, yname, cable)
+            curves, info = _find(fw, cs, (xname, xrange), (yname, yrange), settings)
+            frame, next_id, about = _rows(fw, curves, xname, yname, next_id)
+            frames.append(frame)
+            record["taut_sets"].setdefault(" ".join(taut) or "none", {})[
+                cable and f"switch {cable}" or "fold"] = {**info, **about}  # fmt: skip
+    table = pd.concat(frames, ignore_index=True) if frames else _empty(fw, xname, yname)
+    record.update(
+        window={xname: list(xrange), yname: list(yrange)}, spacing=SPACING, lines=LINES,
+        seed=settings.seed, seconds=time.perf_counter() - t0,
+        counts={k: int((table["kind"] == k).sum()) for k in ("fold", "cusp", "cable_switch")},
+        curves_found=int(table.loc[table["curve_id"] >= 0, "curve_id"].nunique()),
+    )  # fmt: skip
+    return table, record
+
+
+def _check(fw: Framework, xname: str, xrange, yname: str, yrange) -> None:
+    """Refuse bad axes in one line naming the field and the value."""
+    for name in (xname, yname):
+        if name not in fw.values:
+            raise ParameterError(
+                f"{name}: unknown parameter of framework {fw.name!r} "
+                f"(known: {' '.join(fw.values) or 'none'})"
+            )
+    if xname == yname:
+        raise ParameterError(f"param2 = {yname!r}: the map's two parameters must differ")
+    for name, (lo, hi) in ((xname, xrange), (yname, yrange)):
+        if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
+            raise ParameterError(f"{name}: window ({lo}, {hi}) must be finite with from < to")
+
+
+def _centre(cs: CurveSystem, fw: Framework, xname: str, yname: str) -> dict:
+    """The generic set's centre: the file's values, a line through them of unit direction."""
+    d = fw.at_defaults()
+    sx, sy = cs.scales
+    line = {LINE[0]: d.values[xname] / sx, LINE[1]: d.values[yname] / sy, LINE[2]: 1.0,
+            LINE[3]: 0.7}  # fmt: skip
+    out = {**parameter_values(cs, d), **line}
+    return {n: out[n] for n in cs.ps.parameters}
+
+
+def _equations(cs: CurveSystem, P: np.ndarray):
+    """The traced equations of z = (X, mx, my): the curve system's residual and Jacobian."""
+
+    def eqs(z: np.ndarray, zref: np.ndarray):
+        F = np.array([complex(e).real for e in cs.numeric.residual(z, P)])
+        J = np.array([complex(e).real for e in cs.numeric.jacobian(z, P)]).reshape(len(F), len(z))
+        return F, J
+
+    return eqs
+
+
+def _line_seeds(cs, gs, centre, base, win: Window, settings) -> tuple[list, list[dict]]:
+    """Real points of the curve on LINES vertical and LINES horizontal lines of the window."""
+    seeds, lines = [], []
+    (xl, yl), (xh, yh) = win.lo, win.hi
+    specs = [(xv, yl, 0.0, yh - yl) for xv in np.linspace(xl, xh, LINES)]
+    specs += [(xl, yv, xh - xl, 0.0) for yv in np.linspace(yl, yh, LINES)]
+    for x0, y0, dx, dy in specs:
+        target = {**base, LINE[0]: x0, LINE[1]: y0, LINE[2]: dx, LINE[3]: dy}
+        # Straight from the witness set, no fallback: on a line parallel to an axis the curve
+        # system's degree in tline drops, so paths going to infinity are expected, not a failure.
+        ends, rep = track(cs.ps, gs, target, settings)
+        pts = ends.points
+        real = (np.abs(pts.imag) / (1 + np.abs(pts.real))).max(axis=1) < 1e-6 if len(pts) else []
+        found = 0
+        for p in pts[np.asarray(real, dtype=bool)].real if len(pts) else []:
+            t = p[-1]
+            if -1e-9 <= t <= 1 + 1e-9:
+                seeds.append(np.concatenate([p[:-1], [x0 + t * dx, y0 + t * dy]]))
+                found += 1
+        lines.append({"line": [x0, y0, dx, dy], "finite": rep.finite, "infinite": rep.infinite,
+                      "lost": rep.lost, "real_in_window": found})  # fmt: skip
+    return seeds, lines
+
+
+def _find(fw: Framework, cs: CurveSystem, xaxis, yaxis, settings) -> tuple[_Curves, dict]:
+    """Witness set, seeds on lines, and every curve through a seed traced once."""
+    (xname, xrange), (yname, yrange) = xaxis, yaxis
+    t0 = time.perf_counter()
+    centre = _centre(cs, fw, xname, yname)
+    gs = generic_set(cs.ps, settings.seed, centre=centre, groups=cs.groups)
+    t1 = time.perf_counter()
+    sx, sy = cs.scales
+    nz = len(cs.variables)
+    win = Window(nz, nz + 1, (xrange[0] / sx, yrange[0] / sy), (xrange[1] / sx, yrange[1] / sy),
+                 (sx, sy))  # fmt: skip
+    P = np.array([parameter_values(cs, fw)[n] for n in cs.params])
+    base = {n: v for n, v in parameter_values(cs, fw).items() if n in cs.ps.parameters}
+    seeds, lines = _line_seeds(cs, gs, centre, base, win, settings)
+    t2 = time.perf_counter()
+    eqs = _equations(cs, P)
+    traced, skipped = [], 0
+    lengths = [k for k, v in enumerate(cs.variables) if v.startswith("d_")]
+    for z in seeds:
+        if (z[lengths] <= 0).any():
+            continue  # a length never changes sign on a curve (L0 > 0): never physical
+        if any(_on(c.points, z, win, len(cs.variables)) for c in traced):
+            skipped += 1
+            continue
+        traced.append(trace(eqs, z, win, SPACING, HMAX))
+    info = {
+        "generic_set": gs.summary(), "generic_seconds": t1 - t0, "lines_seconds": t2 - t1,
+        "trace_seconds": time.perf_counter() - t2, "seeds": len(seeds), "seeds_on_traced": skipped,
+        "lines": lines, "ends": [list(c.ends) for c in traced],
+        "lost_paths": int(sum(ln["lost"] for ln in lines)),
+    }  # fmt: skip
+    return _Curves(cs, traced, win, eqs), info
+
+
+def _on(points: np.ndarray, z: np.ndarray, win: Window, nx: int) -> bool:
+    """Whether z lies on a traced polyline: near one of its points in the plane and in X."""
+    near_xy = win.xy_distance(points, z) <= 3 * SPACING * win.diagonal
+    near_x = np.abs(points[:, :nx] - z[:nx]).max(axis=1) <= 3 * HMAX
+    return bool((near_xy & near_x).any())
+
+
+def _solution_columns(fw: Framework) -> list[str]:
+    """The solutions.csv columns that describe a configuration (poses to energy)."""
+    names = column_names(fw)
+    return names[1 : names.index("energy") + 1]
+
+
+def _empty(fw: Framework, xname: str, yname: str) -> pd.DataFrame:
+    cols = [xname, yname, *_solution_columns(fw), "curve_id", "arc", "kind", "physical",
+            "changes_stable_count", "taut", "null_cubic"]  # fmt: skip
+    return pd.DataFrame({c: [] for c in cols})
+
+
+def _classify(fw: Framework, cs: CurveSystem, z: np.ndarray, xname: str, yname: str) -> dict:
+    """One point's solution columns, physical, and changes_stable_count (None: an artefact, a
+    singular Jacobian with a regular reduced Hessian)."""
+    sx, sy = cs.scales
+    nx = len(cs.variables)
+    x, y = z[nx] * sx, z[nx + 1] * sy
+    fwp = fw.replace(**{xname: x, yname: y})
+    fs = framework_system(fwp, cs.taut)
+    ends = Endpoints.from_records(fs.ps.variables, [{"coords": z[:nx].astype(complex)}])
+    cols = framework_columns(fwp, fs, ends, units(fw), Tolerances())
+    row = {xname: x, yname: y, **{c: cols[c][0] for c in _solution_columns(fw)}}
+    row["physical"] = bool(cols["physical"][0])
+    index, zero = _index(fs, fwp, z[:nx])
+    if cs.kind == "fold":
+        if not zero:
+            return {**row, "changes_stable_count": None}
+        row["changes_stable_count"] = index == 0  # a minimum meets an index-1 saddle
+    else:
+        # With the cable slack the Hessian loses the cable's positive rank-one term, so its index
+        # is the same or one more. Same index (same sign of the determinant): the equilibrium
+        # passes from one taut set to the other and stays as stable as it was. One more: by the
+        # degree, the two branches end together here (a nonsmooth fold); a stable state is lost
+        # exactly when the taut branch is a minimum.
+        slack = tuple(c for c in cs.taut if c != cs.cable)
+        fss = framework_system(fwp, slack)
+        X = dict(zip(fs.ps.variables, z[:nx], strict=True))
+        index_s, _ = _index(fss, fwp, np.array([X[v] for v in fss.ps.variables]))
+        row["changes_stable_count"] = index == 0 and index_s >= 1
+    return row
+
+
+def _index(fs, fwp: Framework, X: np.ndarray) -> tuple[int, bool]:
+    """The reduced Hessian's index (eigenvalues < 0, the one nearest 0 left out) and whether
+    that one is 0 (within 1e-6 of the largest |eigenvalue|)."""
+    P = np.array(list(normalized_slots(fwp).values()))
+    H, G = local_hessian(fs, X[None, :].real, P)
+    eig = reduced_eigh(H[0], G[0])[0]
+    if not len(eig):
+        return 0, False
+    k = int(np.argmin(np.abs(eig)))
+    zero = abs(eig[k]) <= 1e-6 * max(1.0, float(np.abs(eig).max()))
+    rest = np.delete(eig, k) if zero else eig
+    return int((rest < 0).sum()), bool(zero)
+
+
+def _null_cubic(cs: CurveSystem, eqs, z: np.ndarray) -> float:
+    """|w . F_XX[v, v]| / |F_XX[v, v]| at a fold point (v, w: unit right and left null vectors
+    of J_X F; F_XX[v, v] by central differences): zero at a cusp, not at an ordinary fold."""
+    n = len(cs.variables)
+    _, J = eqs(z, z)
+    u, _, vt = np.linalg.svd(J[:n, :n])
+    v, w = vt[-1], u[:, -1]
+    h = 1e-5
+    shift = np.concatenate([h * v, [0.0, 0.0]])
+    q = (eqs(z + shift, z)[1][:n, :n] - eqs(z - shift, z)[1][:n, :n]) @ v / (2 * h)
+    return float(abs(w @ q) / max(np.linalg.norm(q), 1e-300))
+
+
+def _rows(fw: Framework, curves: _Curves, xname: str, yname: str, next_id: int) -> tuple:
+    """The table of one curve system's curves (physical points only, a curve split where it
+    stops being physical), the next free curve_id, and counts for the record."""
+    cs, win = curves.cs, curves.window
+    kind = "fold" if cs.kind == "fold" else "cable_switch"
+    rows, artefacts, cusps = [], 0, 0
+    for curve in curves.traced:
+        classified = [_classify(fw, cs, z, xname, yname) for z in curve.points]
+        artefacts += sum(r["changes_stable_count"] is None for r in classified)
+        keep = np.array([r["physical"] and r["changes_stable_count"] is not None
+                         for r in classified])  # fmt: skip
+        for run in _runs(keep):
+            pts = curve.points[run]
+            arc = np.concatenate([[0.0], np.cumsum(win.xy_distance(pts[1:], pts[:-1]))])
+            arc /= win.diagonal
+            for k, i in enumerate(run):
+                rows.append({**classified[i], "curve_id": next_id, "arc": arc[k], "kind": kind})
+            if cs.kind == "fold":
+                for k, z in _cusps(curves.eqs, pts, win):
+                    row = _classify(fw, cs, z, xname, yname)
+                    if row["physical"]:
+                        cusps += 1
+                        rows.append({**row, "curve_id": next_id, "arc": arc[k], "kind": "cusp",
+                                     "null_cubic": _null_cubic(cs, curves.eqs, z)})  # fmt: skip
+            next_id += 1
+    frame = pd.DataFrame(rows) if rows else _empty(fw, xname, yname)
+    if "null_cubic" not in frame:
+        frame["null_cubic"] = np.nan
+    frame["taut"] = " ".join(cs.taut) or "none"
+    about = {"curves_traced": len(curves.traced), "points": len(frame), "artefacts": artefacts,
+             "cusps": cusps}  # fmt: skip
+    return frame[list(_empty(fw, xname, yname).columns)], next_id, about
+
+
+def _runs(keep: np.ndarray) -> list[np.ndarray]:
+    """Maximal runs of consecutive True, as index arrays (of two points or more)."""
+    idx = np.flatnonzero(keep)
+    if not len(idx):
+        return []
+    parts = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1)
+    return [p for p in parts if len(p) > 1]
+
+
+def _cusps(eqs, pts: np.ndarray, win: Window) -> list[tuple[int, np.ndarray]]:
+    """(index, refined point) of each cusp of a polyline: where its image turns back."""
+    xy = np.stack([pts[:, win.ix] * win.scale[0], pts[:, win.iy] * win.scale[1]], axis=1)
+    seg = np.diff(xy, axis=0)
+    norm = np.linalg.norm(seg, axis=1)
+    out, k = [], 0
+    while k < len(seg) - 1:
+        a, b = seg[k], seg[k + 1]
+        if norm[k] > 0 and norm[k + 1] > 0 and a @ b < TURN_COS * norm[k] * norm[k + 1]:
+            z = _refine_cusp(eqs, pts[k], pts[k + 2], a / norm[k], win)
+            if z is not None:
+                out.append((k + 1, z))
+            k += 2
+        else:
+            k += 1
+    return out
+
+
+def _refine_cusp(eqs, za: np.ndarray, zb: np.ndarray, e_in: np.ndarray, win: Window):
+    """Bisection between za and zb on the image's speed along the incoming direction e_in."""
+    from .curve_trace import tangent
+
+    t_a = zb - za
+    t_a /= np.linalg.norm(t_a)
+
+    def at(h: float):
+        pred = za + h * t_a
+        z = newton(eqs, pred, za, lambda w: (t_a @ (w - pred), t_a))
+        if z is None:
+            return None, 0.0
+        t = tangent(eqs, z, za)
+        t = t if t @ t_a > 0 else -t
+        return z, t[win.ix] * win.scale[0] * e_in[0] + t[win.iy] * win.scale[1] * e_in[1]
+
+    lo, hi = 0.0, float(np.linalg.norm(zb - za))
+    z_lo, f_lo = at(lo)
+    z_hi, f_hi = at(hi)
+    if z_lo is None or z_hi is None or f_lo * f_hi > 0:
+        return None
+    for _ in range(50):
+        mid = (lo + hi) / 2
+        z, f = at(mid)
+        if z is None:
+            return None
+        if f * f_lo > 0:
+            lo, f_lo = mid, f
+        else:
+            hi = mid
+        z_hi = z if f * f_lo <= 0 else z_hi
+    return at((lo + hi) / 2)[0]

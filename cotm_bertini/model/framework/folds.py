@@ -1,0 +1,276 @@
+"""Curves over two parameters of a framework as polynomial systems: fold curves and cable switches.
+
+For one taut set with equilibrium system F(X; p) = 0 (derive.equilibrium_equations, normalised
+units) and two map parameters (x, y) of the file, a curve is F = 0 plus one more equation:
+
+- fold: the bordered Hessian of the Lagrangian (the reduced Hessian bordered by the constraints'
+  Jacobian, in local coordinates) is singular, its determinant cleared of the springs' 1/d
+  (fold_condition): no null vector among the unknowns, so the system stays as small as F;
+- switch of cable c (taut, L0 > 0): d_c = L0_c (the cable exactly at its free length, so it
+  exerts no force and the equilibrium is also one of the taut set without c).
+
+Each is generated twice from the same sympy expressions: numpy code of the curve's residual and
+Jacobian in Z = (X, mx, my) (mx = x / sx, my = y / sy: the map coordinates in the units of the
+slots they enter) for tracing; and a Bertini system with (mx, my) = (x0, y0) + tline (dx, dy) on a
+line, tline unknown, whose parameters are the line's coefficients and the framework's other
+non-constant slots: solved once at a random complex line (a witness set of the curve), then
+reached on any real line by parameter homotopy. Cached on disk by structure, map parameters and
+curve kind, like compiled.py.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import types
+from dataclasses import asdict, dataclass
+from functools import cache
+from pathlib import Path
+
+import sympy as sp
+
+from ...errors import ParameterError
+from ...fs import atomic_write_text, cache_root, files_hash
+from ..polynomial import ParametricSystem
+from .compiled import framework_system, variable_groups
+from .expressions import Expr
+from .spec import Framework
+from .structure import source_hash, structure_key
+from .units import scale_of, slot_kind, units
+
+LINE = ("line_x0", "line_y0", "line_dx", "line_dy")
+
+
+@dataclass(frozen=True)
+class CurveDerived:
+    """A curve system as plain data (JSON-able)."""
+
+    kind: str  # "fold" or "switch"
+    cable: str  # the cable at its free length (switch), else ""
+    variables: list[str]  # X: the equilibrium system's unknowns, in its order
+    system: dict  # ParametricSystem JSON: unknowns X, tline; parameters LINE + `params`
+    params: list[str]  # the other parameters, in the order of the numeric code's P
+    scales: list[float]  # (sx, sy): user value = scale * map coordinate
+    source: str  # numpy: residual(Z, P), jacobian(Z, P); Z = X, mx, my
+
+
+@dataclass(frozen=True, eq=False)
+class CurveSystem:
+    """A curve system ready to solve and trace."""
+
+    key: str
+    taut: tuple[str, ...]
+    kind: str
+    cable: str
+    variables: tuple[str, ...]
+    ps: ParametricSystem
+    params: tuple[str, ...]
+    scales: tuple[float, float]
+    numeric: types.ModuleType
+    groups: list[list[str]]
+
+
+def to_sympy(e: Expr, symbol) -> sp.Expr:
+    """A file expression as sympy, each parameter name mapped by `symbol(name)`."""
+    if e.op == "num":
+        return sp.nsimplify(e.value) if float(e.value).is_integer() else sp.Float(e.value, 17)
+    if e.op == "name":
+        return symbol(e.name)
+    a = [to_sympy(x, symbol) for x in e.args]
+    if e.op == "neg":
+        return -a[0]
+    ops = {"+": sp.Add, "*": sp.Mul, "-": lambda p, q: p - q, "/": lambda p, q: p / q,
+           "^": sp.Pow}  # fmt: skip
+    return ops[e.op](a[0], a[1])
+
+
+def map_scales(fw: Framework, xname: str, yname: str) -> tuple[float, float]:
+    """Each map parameter's unit: that of the first slot it enters (a length, stiffness or
+    force), so the map coordinates are of order one."""
+    L, K = units(fw)
+    exprs = fw.slot_expressions()
+    out = []
+    for name in (xname, yname):
+        slots = [s for s, e in exprs.items() if name in e.names()]
+        if not slots:
+            raise ParameterError(
+                f"{name}: parameter of framework {fw.name!r} that no number of its equations "
+                "uses (a map over it would be empty)"
+            )
+        out.append(scale_of(slot_kind(slots[0]), L, K))
+    return out[0], out[1]
+
+
+def _slot_substitution(fw: Framework, xname: str, yname: str, mx, my) -> tuple[dict, list]:
+    """sympy substitutions of the slots that name a map parameter (normalised units), and the
+    other parameters they name (symbols par_<name>, user values)."""
+    L, K = units(fw)
+    sx, sy = map_scales(fw, xname, yname)
+    others: list[str] = []
+
+    def symbol(name: str):
+        if name == xname:
+            return sx * mx
+        if name == yname:
+            return sy * my
+        if name not in others:
+            others.append(name)
+        return sp.Symbol(f"par_{name}")
+
+    subs = {}
+    for slot, e in fw.slot_expressions().items():
+        if e.names() & {xname, yname}:
+            subs[sp.Symbol(slot)] = to_sympy(e, symbol) / scale_of(slot_kind(slot), L, K)
+    return subs, others
+
+
+def _upper(m: int) -> list[tuple[int, int]]:
+    return [(i, j) for i in range(m) for j in range(i, m)]
+
+
+def fold_condition(fw: Framework, taut: tuple[str, ...]) -> sp.Expr:
+    """A polynomial in the unknowns and slots that vanishes where the bordered Hessian of the
+    Lagrangian (local coordinates, constraints bordering it) is singular: a fold.
+
+    A spring's energy k/2 (|r| - L0)^2 has second derivatives w (r_i . r_j + r . r_ij) +
+    alpha (r . r_i)(r . r_j) with w = k (1 - L0/d) and alpha = k L0 / d^3 = (k - w) / d^2. The
+    determinant is affine in each alpha (each enters a rank-one term), so multiplying it by every
+    d^2 clears the denominators: alpha -> k - w in a term that has it, else a factor d^2."""
+    from .derive import _active, local_frame
+    from .units import constants
+
+    local, at, pos, cons, loads = local_frame(fw)
+    zfl, m = set(fw.zero_free_length()), len(local)
+    H = sp.zeros(m, m)
+    alphas, laws = [], []
+    for x in _active(fw, taut):
+        r = pos.of(x.a) - pos.of(x.b)
+        r0 = r.subs(at)
+        ri = [sp.diff(r, a).subs(at) for a in local]
+        k = sp.Symbol(f"k_{x.name}")
+        w = k if x.name in zfl else sp.Symbol(f"w_{x.name}")
+        if x.name not in zfl:
+            alpha = sp.Symbol(f"alpha_{x.name}")
+            alphas.append(alpha)
+            laws.append((k - w, sp.Symbol(f"d_{x.name}") ** 2))
+        for i, j in _upper(m):
+            term = w * (ri[i].dot(ri[j]) + r0.dot(sp.diff(r, local[i], local[j]).subs(at)))
+            if x.name not in zfl:
+                term += alpha * r0.dot(ri[i]) * r0.dot(ri[j])
+            H[i, j] += term
+    L = -loads + sum(sp.Symbol(name) * g for g, name, _, _ in cons)
+    for i, j in _upper(m):
+        H[i, j] += sp.diff(L, local[i], local[j]).subs(at)
+        H[j, i] = H[i, j]
+    G = sp.Matrix([[sp.diff(g, a).subs(at) for a in local] for g, *_ in cons])
+    B = H if not len(cons) else sp.Matrix(sp.BlockMatrix([[H, G.T], [G, sp.zeros(len(cons))]]))
+    det = sp.expand(B.det(method="berkowitz"))
+    out = sp.Integer(0)
+    for monomial, coeff in sp.Poly(det, *alphas).terms() if alphas else [((), det)]:
+        factor = sp.Integer(1)
+        for e, (has, lacks) in zip(monomial, laws, strict=True):
+            factor *= has if e else lacks
+        out += coeff * factor
+    const = {sp.Symbol(n): sp.Float(v, 17) for n, v in constants(fw).items()}
+    return sp.expand(out.xreplace(const))
+
+
+def _derive(fw: Framework, taut: tuple[str, ...], xname: str, yname: str, cable: str) -> dict:
+    """The curve system (fold when `cable` is empty, else that cable's switch) as plain data."""
+    from ..symbolic import numpy_function, parametric_from_sympy
+    from .derive import equilibrium_equations
+
+    names, _, F, _ = equilibrium_equations(fw, taut)
+    X = [sp.Symbol(n) for n in names]
+    mx, my, t = sp.symbols("map_x map_y tline")
+    subs, _ = _slot_substitution(fw, xname, yname, mx, my)
+    extra = (
+        sp.Symbol(f"d_{cable}") - sp.Symbol(f"L0_{cable}") if cable else fold_condition(fw, taut)
+    )
+    G = [sp.expand(g.xreplace(subs)) for g in [*F, extra]]
+    Z = [*X, mx, my]
+    jac = sp.Matrix(G).jacobian(Z)
+    slots_used = sorted({s.name for g in G for s in g.free_symbols} - {z.name for z in Z})
+    args = {"Z": Z, "P": [sp.Symbol(n) for n in slots_used]}
+    source = "from numpy import sqrt\n\n" + numpy_function("residual", args, G)
+    source += numpy_function("jacobian", args, list(jac))
+    line = {mx: sp.Symbol(LINE[0]) + t * sp.Symbol(LINE[2]),
+            my: sp.Symbol(LINE[1]) + t * sp.Symbol(LINE[3])}  # fmt: skip
+    eqs = [sp.expand(g.xreplace(line)) for g in G]
+    try:
+        ps = parametric_from_sympy((*names, t.name), tuple(f"g{i + 1}" for i in range(len(eqs))),
+                                   tuple(eqs), LINE + tuple(slots_used))  # fmt: skip
+    except sp.PolynomialError as exc:
+        raise ParameterError(
+            f"{xname}, {yname}: a map parameter enters a number of framework {fw.name!r} "
+            f"other than polynomially ({exc}); a fold map needs polynomial equations"
+        ) from None
+    return asdict(
+        CurveDerived(
+            "switch" if cable else "fold",
+            cable,
+            names,
+            ps.to_json(),
+            slots_used,
+            list(map_scales(fw, xname, yname)),
+            source,
+        )  # fmt: skip
+    )
+
+
+@cache
+def _code_hash() -> str:
+    return files_hash((Path(__file__).resolve(),)) + source_hash()
+
+
+def curve_key(fw: Framework, taut: tuple[str, ...], xname: str, yname: str, cable: str) -> str:
+    """Content hash of what a curve system depends on."""
+    exprs = {s: repr(e) for s, e in fw.slot_expressions().items() if e.names() & {xname, yname}}
+    blob = json.dumps(
+        {"s": structure_key(fw, taut), "map": [xname, yname], "cable": cable, "exprs": exprs,
+         "units": units(fw), "code": _code_hash()}, sort_keys=True,
+    )  # fmt: skip
+    return hashlib.sha256(blob.encode()).hexdigest()[:16]
+
+
+_LOADED: dict[str, CurveSystem] = {}
+
+
+def curve_system(
+    fw: Framework, taut: tuple[str, ...], xname: str, yname: str, cable: str = ""
+) -> CurveSystem:
+    """The fold system (cable "") or a cable's switch system of a taut set, from memory, the
+    disk cache, or derived with sympy."""
+    taut = tuple(sorted(taut))
+    key = curve_key(fw, taut, xname, yname, cable)
+    if key in _LOADED:
+        return _LOADED[key]
+    path = cache_root() / "frameworks" / f"curve-{key}.json"
+    data = None
+    if path.is_file():
+        try:
+            data = CurveDerived(**json.loads(path.read_text()))
+        except (ValueError, TypeError):
+            data = None  # damaged: derive again
+    if data is None:
+        data = CurveDerived(**_derive(fw, taut, xname, yname, cable))
+        atomic_write_text(path, json.dumps(asdict(data)))
+    module = types.ModuleType(f"cotm_curve_{key}")
+    exec(compile(data.source, str(path), "exec"), module.__dict__)
+    groups = [*variable_groups(framework_system(fw, taut)), ["tline"]]
+    out = CurveSystem(
+        key, taut, data.kind, data.cable, tuple(data.variables),
+        ParametricSystem.from_json(data.system), tuple(data.params),
+        (data.scales[0], data.scales[1]), module, groups,
+    )  # fmt: skip
+    _LOADED[key] = out
+    return out
+
+
+def parameter_values(cs: CurveSystem, fw: Framework) -> dict[str, float]:
+    """The values of the curve system's non-line parameters at `fw`'s values (slots normalised,
+    par_<name> the user's value)."""
+    from .units import normalized_slots
+
+    slots, values = normalized_slots(fw), fw.values
+    return {n: (values[n[4:]] if n.startswith("par_") else slots[n]) for n in cs.params}

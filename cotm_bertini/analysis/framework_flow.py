@@ -146,8 +146,8 @@ class FrameworkFlow:
         """Eigenpairs of the Lagrangian's Hessian on the tangent space, for the cables taut at
         x (normalised units); none where that structure moves freely."""
         lengths = self._lengths(self._coords(x))
-        taut = tuple(x.name for x, d, L0 in zip(self.links, lengths, self.L0, strict=True)
-                     if x.kind == "cable" and d > L0)  # fmt: skip
+        taut = tuple(link.name for link, d, L0 in zip(self.links, lengths, self.L0, strict=True)
+                     if link.kind == "cable" and d > L0)  # fmt: skip
         fs = framework_system(self.fw, taut)
         if fs.free:
             return np.zeros(0), np.zeros((self.m, 0))

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Iterator
 
-from ..errors import ParameterError
+from ..errors import CotmError, ParameterError, SolverError
 
 CONNECT_SECONDS = 10.0  # how long to wait for a scheduler to answer before giving up
 
@@ -52,4 +52,13 @@ def run_jobs(
         futures = client.map(fn, list(jobs), pure=False)
         where = {f.key: k for k, f in enumerate(futures)}
         for fut in as_completed(futures):
-            yield where[fut.key], fut.result()
+            try:
+                result = fut.result()
+            except CotmError:
+                raise
+            except Exception as exc:  # a task's error, or a worker lost: the solve failed
+                raise SolverError(
+                    f"a task on the Dask cluster at {scheduler} failed: {type(exc).__name__}: "
+                    f"{str(exc).splitlines()[0] if str(exc) else ''}"
+                ) from exc
+            yield where[fut.key], result

@@ -274,8 +274,12 @@ def _bertini_solve(system, seed: int, groups) -> tuple[tuple, dict]:
         _end_points(pts, len(system.variables)),
     )
     start = "multihomogeneous" if groups else "total-degree"
-    route = {"method": f"bertini {start} start (ZeroDimSolver), one call"}
-    return ends, {**route, "cpu_seconds": round(time.process_time() - cpu, 3)}
+    route = {
+        "method": f"bertini {start} start (ZeroDimSolver), one call",
+        "cpu_seconds": round(time.process_time() - cpu, 3),
+        "failed_paths": _failed(ends[0]),
+    }
+    return ends, route
 
 
 def _split_solve(system, seed: int, groups, scheduler: str) -> tuple[tuple, dict]:
@@ -318,9 +322,14 @@ def _split_solve(system, seed: int, groups, scheduler: str) -> tuple[tuple, dict
         "chunk_seconds": [round(c["seconds"], 3) for c in chunks],
         "cpu_seconds": round(sum(c["cpu_seconds"] for c in chunks) + again_cpu, 3),
         "retracked_adaptive": sum(c["retracked_adaptive"] for c in chunks) + len(twins),
-        "failed_paths": sum(c != _SUCCESS and c not in INFINITE_CODES for c in ends[0]),
+        "failed_paths": _failed(ends[0]),
     }
     return (*ends, pts), route
+
+
+def _failed(codes: list[str]) -> int:
+    """Paths that ended neither at a finite point nor on the way to infinity (lost)."""
+    return sum(c != _SUCCESS and c not in INFINITE_CODES for c in codes)
 
 
 def _twins(codes: list, finite: list, singular: list, pts: np.ndarray) -> list[int]:

@@ -101,6 +101,27 @@ REGIONS = {
     "stable": "the number of stable equilibria there",
 }
 
+FRAMEWORK_FOLDS = {
+    "<x>, <y>": "the two map parameters (named as in the file, its units) at the point",
+    "framework solutions.csv columns": "the pose, positions, link lengths and tensions and the "
+    "energy of the equilibrium at the point, named as in the framework's solutions.csv",
+    "curve_id": "the traced curve the point lies on (a curve is split where it stops being "
+    "physical); its rows in order of `arc` form a polyline",
+    "arc": "distance along the curve's image in the plane from its first point, in units of the "
+    "window's diagonal",
+    "kind": "fold (the reduced Hessian singular: two equilibria meet), cusp (where a fold curve's "
+    "image turns back; confirmed by null_cubic), or cable_switch (a taut cable exactly at its "
+    "free length: the equilibrium passes between taut sets)",
+    "physical": "the equilibrium at the point is physical (real, lengths > 0, taut set "
+    "consistent); a map keeps only these, inside its window",
+    "changes_stable_count": "crossing the curve here changes the number of stable equilibria (a "
+    "minimum meets an index-1 saddle, or a stable taut branch ends at a cable switch); false for "
+    "two maxima, or a saddle and a maximum, meeting",
+    "taut": "the taut set of cables whose system the point solves (none: no cable taut)",
+    "null_cubic": "at a cusp: |w . F_XX[v, v]| / |F_XX[v, v]| (v, w the null vectors of the "
+    "equilibrium Jacobian), 0 at a cusp up to the finite differences; empty elsewhere",
+}
+
 FRAMEWORK_REGIONS = {
     "<x>, <y>": "a grid point of a framework's map, in the units of its file (the two map "
     "parameters, named as in the file): the window's ends and the evenly spaced values between, "
@@ -283,7 +304,8 @@ def markdown(title: str, columns: dict[str, str], head: str = "column") -> str:
 def reference(*tables: str, title: str = "Columns of the CSV files in this folder") -> str:
     """The column reference of a run folder: 'solutions', 'counts', 'sweep', 'events',
     'barriers', 'folds', 'regions', 'design', 'framework', 'framework_counts',
-    'framework_sweep', 'framework_events', 'framework_regions', 'framework_barriers'."""
+    'framework_sweep', 'framework_events', 'framework_folds', 'framework_regions',
+    'framework_barriers'."""
     known = {
         "solutions": ("solutions.csv", SOLUTIONS),
         "counts": ("counts (run.json `counts`, `res.counts`)", COUNTS, "count"),
@@ -298,6 +320,7 @@ def reference(*tables: str, title: str = "Columns of the CSV files in this folde
         "framework_counts": ("counts of a framework solve", FRAMEWORK_COUNTS, "count"),
         "framework_sweep": ("sweep.csv of a framework", FRAMEWORK_SWEEP),
         "framework_events": ("events.csv of a framework", FRAMEWORK_EVENTS),
+        "framework_folds": ("folds.csv of a framework's map", FRAMEWORK_FOLDS),
         "framework_regions": ("regions.csv of a framework's map", FRAMEWORK_REGIONS),
     }
     parts = [f"# {title}\n"]
@@ -320,6 +343,7 @@ def document() -> str:
         "framework_counts",
         "framework_sweep",
         "framework_events",
+        "framework_folds",
         "framework_regions",
         "framework_barriers",
         title="Columns of the CSV files",

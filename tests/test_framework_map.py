@@ -81,37 +81,44 @@ def _scan_counts(x: float, y: float, cables: bool, n: int = 20_000) -> tuple[int
     return int(change.sum()), int(minima.sum())
 
 
-@pytest.fixture(scope="module")
-def zeeman_map():
-    fw = cb.Framework.from_toml(f"{EXAMPLES}/zeeman.toml")
-    return cb.design_map(fw, "x", WINDOW["x"], "y", WINDOW["y"], points=N, workers=2)
+@pytest.fixture(scope="module", params=["zeeman", "zeeman_cables"])
+def zeeman_map(request):
+    fw = cb.Framework.from_toml(f"{EXAMPLES}/{request.param}.toml")
+    m = cb.design_map(fw, "x", WINDOW["x"], "y", WINDOW["y"], points=N, workers=2)
+    return m, request.param == "zeeman_cables"
 
 
 def test_zeeman_regions_match_a_scan_of_the_energy(zeeman_map):
-    regions = zeeman_map.regions
+    m, cables = zeeman_map
+    regions = m.regions
     assert list(regions.columns) == ["x", "y", "physical", "stable"]
     assert np.array_equal(np.unique(regions.x), grid_values(*WINDOW["x"], N))
     for _, r in regions.iterrows():
-        critical, minima = _scan_counts(r.x, r.y, cables=False)
+        critical, minima = _scan_counts(r.x, r.y, cables)
         assert (r.physical, r.stable) == (critical, minima), (r.x, r.y)
-    assert set(regions.stable) == {1, 2}  # the diamond is bistable, the rest not
+    assert set(regions.stable) == {1, 2}  # the bistable diamond, and the rest
 
 
 def test_zeeman_map_count_changes_are_explained(zeeman_map):
-    rec = zeeman_map.record
+    m, cables = zeeman_map
+    rec = m.record
     assert rec["count_changes"] > 10
     assert rec["unexplained_changes"] == 0, rec["unexplained"]
-    assert rec["status"] == "ok" and zeeman_map.status == "ok"
-    missed, _ = unexplained(zeeman_map.regions, zeeman_map.folds, "x", "y")
+    assert rec["status"] == "ok" and m.status == "ok"
+    missed, _ = unexplained(m.regions, m.folds, "x", "y")
     assert missed.empty
+    # Without the curves that change the stable count, the changes are not explained.
+    bare = m.folds.assign(changes_stable_count=False, kind="fold")
+    assert len(unexplained(m.regions, bare, "x", "y")[0]) == rec["count_changes"]
 
 
 def test_zeeman_map_cusps_and_folds(zeeman_map):
-    folds = zeeman_map.folds
-    assert folds.physical.all()
+    m, _ = zeeman_map
+    folds = m.folds
+    assert folds.physical.all() and len(folds) > 0
     assert folds.x.between(*WINDOW["x"]).all() and folds.y.between(*WINDOW["y"]).all()
-    assert zeeman_map.cusps.kind.eq("cusp").all()
-    assert len(zeeman_map.cusps) == zeeman_map.record["cusps"]
+    assert m.cusps.kind.eq("cusp").all() and len(m.cusps) == m.record["cusps"]
+    assert m.axes == ("x", "y") and set(m.record["timings"]) >= {"folds", "regions"}
 
 
 # ---- the command line ---------------------------------------------------------------------
@@ -126,7 +133,6 @@ ZEEMAN_ARGS = ("map", "--framework", f"{EXAMPLES}/zeeman.toml", "--quiet")
           "--to2", "1"), "--param 'z'"),
         (("--param", "x", "--from", "0", "--to", "1", "--param2", "y", "--from2", "0"),
          "--to2 is required"),
-        (("--param", "x", "--from", "0", "--to", "1"), "--param2 is required"),
         (("--param", "x", "--from", "1", "--to", "0", "--param2", "y", "--from2", "0",
           "--to2", "1"), "x: the range 1 to 0 is empty"),
     ],
@@ -157,3 +163,25 @@ def test_map_framework_writes_the_map(tmp_path):
     line = next(ln for ln in run.stdout.splitlines() if ln.startswith("map:"))
     assert "in the window x -0.6..0.8, y -0.8..0.2" in line
     assert f"{len(folds)} fold points" in line
+
+
+# ---- make stress: the completeness check on two-body and closed-loop frameworks --------------
+
+STRESS_MAPS = {
+    "double_pendulum": ("weight", (0.0, 1.0), "L0", (0.2, 1.0)),
+    "fourbar": ("ex", (0.0, 2.0), "ey", (1.0, 3.0)),
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", sorted(STRESS_MAPS))
+def test_map_count_changes_are_explained_stress(name):
+    """Every stable-count change between grid neighbours is crossed by a fold curve that changes
+    it (make stress: minutes each)."""
+    x, xr, y, yr = STRESS_MAPS[name]
+    fw = cb.Framework.from_toml(f"{EXAMPLES}/{name}.toml")
+    m = cb.design_map(fw, x, xr, y, yr, points=21, workers=2)
+    rec = m.record
+    assert rec["sweep_status"] == "ok"
+    assert rec["unexplained_changes"] == 0, rec["unexplained"]
+    assert m.status == "ok"

@@ -123,8 +123,6 @@ def test_a_bad_param_is_refused_naming_it(capsys, tmp_path):
     fw = cb.Framework.from_toml(ZEEMAN)
     with pytest.raises(cb.ParameterError, match="'z': unknown parameter of framework"):
         cb.sweep(fw, "z", [0.0, 1.0], out=tmp_path)
-    with pytest.raises(cb.ParameterError, match="certify"):
-        cb.sweep(fw, "y", [0.0, 1.0], out=tmp_path, certify=True)
 
 
 def test_resume_after_an_interruption(tmp_path, zeeman_sweep):

@@ -57,7 +57,7 @@ def map_figure(
     else:
         others = [f"{n} = {v:g}" for n, v in params.as_dict().items() if n not in axes]
         title = f"{params.name}: stable equilibria over ({xname}, {yname}), with the fold curves"
-        title += "\n" + (", ".join(others) if others else f"{xname}, {yname}: its parameters")
+        title += "\n" + ", ".join(others) if others else ""
     ax.set_title(title, fontsize=10)
     ax.legend(handles=handles, loc="upper right", fontsize=8)
     return fig

@@ -118,8 +118,9 @@ FRAMEWORK_FOLDS = {
     "minimum meets an index-1 saddle, or a stable taut branch ends at a cable switch); false for "
     "two maxima, or a saddle and a maximum, meeting",
     "taut": "the taut set of cables whose system the point solves (none: no cable taut)",
-    "null_cubic": "at a cusp: |w . F_XX[v, v]| / |F_XX[v, v]| (v, w the null vectors of the "
-    "equilibrium Jacobian), 0 at a cusp up to the finite differences; empty elsewhere",
+    "null_cubic": "fold and cusp rows: |w . F_XX[v, v]| / |F_XX[v, v]| (v, w the unit right and "
+    "left null vectors of the equilibrium Jacobian J_X F, F_XX[v, v] by central differences): "
+    "the energy's cubic term along the null direction, 0 at a cusp; empty at cable switches",
 }
 
 FRAMEWORK_REGIONS = {

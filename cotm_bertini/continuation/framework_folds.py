@@ -273,6 +273,9 @@ def _rows(fw: Framework, curves: _Curves, xname: str, yname: str, next_id: int) 
     rows, artefacts, cusps = [], 0, 0
     for curve in curves.traced:
         classified = [_classify(fw, cs, z, xname, yname) for z in curve.points]
+        if cs.kind == "fold":
+            for r, z in zip(classified, curve.points, strict=True):
+                r["null_cubic"] = _null_cubic(cs, curves.eqs, z)
         artefacts += sum(r["changes_stable_count"] is None for r in classified)
         keep = np.array([r["physical"] and r["changes_stable_count"] is not None
                          for r in classified])  # fmt: skip

@@ -1,0 +1,187 @@
+"""Fold curves, cusps and cable switches of frameworks (issue 19), against independent routes:
+dense scans of plain-numpy energies (tests/framework_physics.py) and the paper's closed form."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from framework_physics import scan_critical_points, zeeman_energy
+
+import cotm_bertini as cb
+from cotm_bertini.continuation.framework_folds import SPACING, framework_fold_curves
+from cotm_bertini.errors import ParameterError
+
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+ZEEMAN_WINDOW = ((-0.6, 0.8), (-0.8, 0.2))
+
+
+def _scanned_folds_along_x(x: float) -> list[float]:
+    """The y where the number of minima of the independent V changes along the line x, bisected
+    on dense scans."""
+    ys = np.linspace(*ZEEMAN_WINDOW[1], 401)
+    counts = np.array([_minima((x, y)) for y in ys])
+    out = []
+    for k in np.flatnonzero(np.diff(counts)):
+        a, b = ys[k], ys[k + 1]
+        for _ in range(34):
+            m = (a + b) / 2
+            a, b = (m, b) if _minima((x, m), 100_000) == counts[k] else (a, m)
+        out.append((a + b) / 2)
+    return out
+
+
+def test_fold_condition_vanishes_at_the_scanned_folds_only():
+    """The fold system's extra equation (the bordered Hessian's determinant cleared of 1/d),
+    evaluated at the double roots of the independent V' along x = 0.1 and at its ordinary
+    critical points: zero at the first, not at the second. Cheap: no Bertini solve."""
+    from cotm_bertini.model.framework.folds import curve_system, parameter_values
+    from cotm_bertini.model.framework.units import units
+
+    fw = cb.Framework.from_toml(EXAMPLES / "zeeman.toml").replace(x=0.1, y=-0.3)
+    cs = curve_system(fw, (), "x", "y")
+    P = np.array([parameter_values(cs, fw)[n] for n in cs.params])
+    L, K = units(fw)
+
+    def fold_value(theta: float, u) -> tuple[float, float]:
+        rim = np.array([1.0 + 0.5 * np.cos(theta), 0.5 * np.sin(theta)])
+        X = {"c_wheel": np.cos(theta), "s_wheel": np.sin(theta)}
+        for band, anchor in (("band_u", u), ("band_p", (2.0, 0.25))):
+            d = np.hypot(*(rim - anchor))
+            X[f"d_{band}"], X[f"w_{band}"] = d / L, (1.0 - 0.25 / d) / K
+        z = np.array([X[v] for v in cs.variables] + [u[0] / cs.scales[0], u[1] / cs.scales[1]])
+        res = np.array([float(r) for r in cs.numeric.residual(z, P)])
+        return float(np.abs(res[:-1]).max()), float(abs(res[-1]))
+
+    folds = _scanned_folds_along_x(0.1)
+    assert len(folds) == 2
+    for y in folds:
+        # Just on the side with the extra pair: the closest min-max pair is the merging one.
+        crit = scan_critical_points(lambda t, y=y: zeeman_energy(t, (0.1, y + 1e-9), False))
+        thetas = np.sort([t for t, _ in crit])
+        gaps = np.diff(np.append(thetas, thetas[0] + 2 * np.pi))
+        if len(thetas) == 2:
+            crit = scan_critical_points(lambda t, y=y: zeeman_energy(t, (0.1, y - 1e-9), False))
+            thetas = np.sort([t for t, _ in crit])
+            gaps = np.diff(np.append(thetas, thetas[0] + 2 * np.pi))
+        k = int(np.argmin(gaps))
+        double = thetas[k] + gaps[k] / 2
+        others = [t for t in thetas if abs(np.angle(np.exp(1j * (t - double)))) > 1e-3]
+        balance, at_fold = fold_value(double, (0.1, y))
+        assert balance < 1e-6 and len(others) >= 2
+        assert at_fold < 1e-2 * min(fold_value(t, (0.1, y))[1] for t in others)
+
+
+@pytest.fixture(scope="module")
+def zeeman():
+    fw = cb.Framework.from_toml(EXAMPLES / "zeeman.toml")
+    table, record = framework_fold_curves(fw, "x", ZEEMAN_WINDOW[0], "y", ZEEMAN_WINDOW[1])
+    return table, record
+
+
+def _dV(theta, u, h=1e-5):
+    return (zeeman_energy(theta + h, u, False) - zeeman_energy(theta - h, u, False)) / (2 * h)
+
+
+def _d2V(theta, u, h=1e-4):
+    f = zeeman_energy
+    return (f(theta + h, u, False) - 2 * f(theta, u, False) + f(theta - h, u, False)) / h**2
+
+
+def _minima(u, n: int = 20000) -> int:
+    """Minima of the independent V(theta) at u: sign changes - to + of V' on a dense grid."""
+    t = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
+    g = _dV(t, u)
+    return int(((g < 0) & (np.roll(g, -1) >= 0)).sum())
+
+
+@pytest.mark.slow  # the fold system's witness set: minutes cold (see docs/design.md)
+def test_zeeman_fold_points_are_folds_of_the_independent_energy(zeeman):
+    table, _ = zeeman
+    folds = table[table["kind"] == "fold"]
+    assert len(folds) > 100 and folds["physical"].all()
+    theta = np.radians(folds["wheel.angle_deg"].to_numpy())
+    u = (folds["x"].to_numpy(), folds["y"].to_numpy())
+    assert np.abs(_dV(theta, u)).max() < 1e-8
+    assert np.abs(_d2V(theta, u)).max() < 1e-5  # V'' scale ~ 0.1-1: a double root of V'
+
+
+@pytest.mark.slow  # the fold system's witness set: minutes cold (see docs/design.md)
+def test_zeeman_is_the_diamond(zeeman):
+    table, record = zeeman
+    assert record["curves_found"] == 1 and record["counts"]["cusp"] == 4
+    ends = [e for ts in record["taut_sets"].values() for r in ts.values() for e in r["ends"]]
+    assert ends == [["closed", "closed"]]
+    cusps = table[table["kind"] == "cusp"]
+    assert (cusps["null_cubic"] < 1e-6).all()
+    folds = table[table["kind"] == "fold"]
+    cusp_xy = cusps[["x", "y"]].to_numpy()
+    far = np.hypot(*(folds[["x", "y"]].to_numpy()[:, None, :] - cusp_xy).transpose(2, 0, 1))
+    assert np.median(folds["null_cubic"][far.min(axis=1) > 0.05]) > 1e-3
+    # Two cusps on the axis of symmetry (through the pivot c = (1, 0) and p = (2, 0.25)), the
+    # other two mirror images of each other in it.
+    axis = np.array([1.0, 0.25]) / np.hypot(1.0, 0.25)
+    rel = cusp_xy - np.array([1.0, 0.0])
+    off = rel @ np.array([-axis[1], axis[0]])
+    assert (np.abs(off) < 1e-6).sum() == 2
+    pair = rel[np.abs(off) >= 1e-6]
+    mirror = 2 * np.outer(pair @ axis, axis) - pair
+    assert np.abs(mirror[::-1] - pair).max() < 1e-6
+
+
+@pytest.mark.slow  # the fold system's witness set: minutes cold (see docs/design.md)
+def test_zeeman_folds_along_x_0_1_agree_with_a_dense_scan(zeeman):
+    """The y where the number of minima changes along x = 0.1, bisected on a dense scan of the
+    independent energy, against the fold curve's crossings of x = 0.1."""
+    table, _ = zeeman
+    scanned = _scanned_folds_along_x(0.1)
+    folds = table[table["kind"] == "fold"].sort_values(["curve_id", "arc"])
+    crossings = []
+    for _, c in folds.groupby("curve_id"):
+        x, y = c["x"].to_numpy(), c["y"].to_numpy()
+        for i in np.flatnonzero(np.sign(x[:-1] - 0.1) != np.sign(x[1:] - 0.1)):
+            crossings.append(y[i] + (0.1 - x[i]) * (y[i + 1] - y[i]) / (x[i + 1] - x[i]))
+    assert len(scanned) == 2 and len(crossings) == 2
+    # The polyline's chord: within its spacing squared times the curvature.
+    assert np.abs(np.sort(crossings) - np.sort(scanned)).max() < 2e-4
+
+
+@pytest.mark.slow  # the fold system's witness set: minutes cold (see docs/design.md)
+def test_zeeman_stable_count_changes_across_every_arc(zeeman):
+    """Across each fold point (away from the cusps) the independent scan's number of minima
+    changes by one exactly where changes_stable_count says so."""
+    table, _ = zeeman
+    cusp_xy = table.loc[table["kind"] == "cusp", ["x", "y"]].to_numpy()
+    folds = table[table["kind"] == "fold"].sort_values(["curve_id", "arc"])
+    xy = folds[["x", "y"]].to_numpy()
+    checked = 0
+    for k in range(1, len(xy) - 1, 15):
+        if np.hypot(*(cusp_xy - xy[k]).T).min() < 0.05:
+            continue
+        tangent = xy[k + 1] - xy[k - 1]
+        normal = np.array([-tangent[1], tangent[0]]) / np.linalg.norm(tangent)
+        step = 2e-3 * normal
+        change = abs(_minima(tuple(xy[k] + step)) - _minima(tuple(xy[k] - step)))
+        assert change == (1 if folds["changes_stable_count"].iloc[k] else 0)
+        checked += 1
+    assert checked > 10
+
+
+@pytest.mark.slow  # the fold system's witness set: minutes cold (see docs/design.md)
+def test_polylines_are_ordered_and_dense(zeeman):
+    table, _ = zeeman
+    diag = np.hypot(*(np.diff(w)[0] for w in ZEEMAN_WINDOW))
+    for _, c in table[table["kind"] == "fold"].groupby("curve_id"):
+        c = c.sort_values("arc")
+        gaps = np.hypot(np.diff(c["x"]), np.diff(c["y"]))
+        assert gaps.max() <= SPACING * diag * (1 + 1e-6)
+        assert np.allclose(np.diff(c["arc"]), gaps / diag)
+
+
+def test_bad_axes_are_refused():
+    fw = cb.Framework.from_toml(EXAMPLES / "zeeman.toml")
+    with pytest.raises(ParameterError, match="^z: unknown parameter"):
+        framework_fold_curves(fw, "z", (0, 1), "y", (0, 1))
+    with pytest.raises(ParameterError, match="^x: window"):
+        framework_fold_curves(fw, "x", (1, 0), "y", (0, 1))

@@ -22,7 +22,11 @@ def main() -> None:
     ap.add_argument("--points", type=int, default=41, help="grid points a side of the map")
     ap.add_argument("--zeeman-points", type=int, default=101, help="Zeeman map grid a side")
     ap.add_argument("--zeeman-only", action="store_true", help="only the Zeeman map")
+    ap.add_argument("--folds-only", action="store_true", help="only the frameworks' fold curves")
     args = ap.parse_args()
+    if args.folds_only:
+        framework_folds()
+        return
     if args.zeeman_only:
         framework_map(args.zeeman_points)
         return
@@ -57,6 +61,43 @@ def main() -> None:
         print(f"  {case}: {len(found.table)} saddles, {len(found.pairs)} pairs, "
               f"{found.seconds:.2f} s")  # fmt: skip
     framework_map(args.zeeman_points)
+    framework_folds()
+
+
+def _fold_run(fw, x: str, xr: tuple, y: str, yr: tuple) -> tuple[float, float, dict]:
+    """(wall seconds, of which the witness sets' solve or load, the record) of one fold map."""
+    from cotm_bertini.continuation.framework_folds import framework_fold_curves
+
+    t0 = time.perf_counter()
+    _, rec = framework_fold_curves(fw, x, xr, y, yr)
+    witness = sum(r["generic_seconds"] for ts in rec["taut_sets"].values() for r in ts.values())
+    return time.perf_counter() - t0, witness, rec
+
+
+def framework_folds() -> None:
+    """Fold curves by the Bertini route (continuation/framework_folds.py): Zeeman over the
+    issue's window, and cotm.toml over (0, 14]^2 against the closed-form route's time on the
+    built-in model (target: at most 10 times it), each run twice (the witness sets solved, or
+    loaded from the cache, then in memory)."""
+    from cotm_bertini.analysis.fold_curves import fold_curves_proved
+
+    runs = [("zeeman", "x", (-0.6, 0.8), "y", (-0.8, 0.2)),
+            ("cotm", "L01", (1e-9, 14.0), "L02", (1e-9, 14.0))]  # fmt: skip
+    for name, x, xr, y, yr in runs:
+        fw = cb.Framework.from_toml(f"examples/{name}.toml")
+        first, witness, rec = _fold_run(fw, x, xr, y, yr)
+        again, _, _ = _fold_run(fw, x, xr, y, yr)
+        print(f"== fold curves of {name}.toml by Bertini, {x} x {y} ==")
+        print(f"  first run {first:.1f} s (witness sets {witness:.1f} s), again {again:.1f} s; "
+              f"{rec['counts']} on {rec['curves_found']} curves")  # fmt: skip
+        if name == "cotm":
+            t0 = time.perf_counter()
+            fold_curves_proved(cb.Params.case("case3"))
+            closed = time.perf_counter() - t0
+            print(
+                f"  closed form (fold_curves_proved, Table 1) {closed:.2f} s: ratio "
+                f"{again / closed:.1f} cached, {first / closed:.1f} first (target <= 10)"
+            )
 
 
 def framework_map(points: int = 101) -> None:

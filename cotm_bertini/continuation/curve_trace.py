@@ -132,7 +132,8 @@ def _one_way(eqs: Equations, z0: np.ndarray, t0: np.ndarray, win: Window, spacin
             if new is not None:
                 t_new = tangent(eqs, new, z)
                 t_new = t_new if t_new @ t > 0 else -t_new
-                if t_new @ t > 0.5 and np.linalg.norm(new - z) < 2 * h:
+                close = win.xy_distance(new, z) <= spacing * win.diagonal
+                if t_new @ t > 0.5 and np.linalg.norm(new - z) < 2 * h and close:
                     break
             h /= 2
             if h < MIN_STEP:

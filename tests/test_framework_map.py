@@ -81,11 +81,31 @@ def _scan_counts(x: float, y: float, cables: bool, n: int = 20_000) -> tuple[int
     return int(change.sum()), int(minima.sum())
 
 
+ZEEMAN_ARGS = ("map", "--framework", f"{EXAMPLES}/zeeman.toml", "--quiet")
+CLI_WINDOW = ("--param", "x", "--from", "-0.6", "--to", "0.8", "--param2", "y",
+              "--from2", "-0.8", "--to2", "0.2", "--points", str(N))  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def zeeman_cli(tmp_path_factory):
+    """`map --framework examples/zeeman.toml` over the issue's window: the run and its folder."""
+    out = tmp_path_factory.mktemp("zeeman-map")
+    run = run_cli(*ZEEMAN_ARGS, *CLI_WINDOW, "--workers", "2", "--out", str(out))
+    assert run.returncode == 0, run.stderr
+    return run, (out / "latest").resolve()
+
+
 @pytest.fixture(scope="module", params=["zeeman", "zeeman_cables"])
 def zeeman_map(request):
+    """The springs' map as `map` saved it (read back), the cables' by cb.design_map."""
     fw = cb.Framework.from_toml(f"{EXAMPLES}/{request.param}.toml")
+    if request.param == "zeeman":
+        _, folder = request.getfixturevalue("zeeman_cli")
+        rec = json.loads((folder / "run.json").read_text())
+        tables = [pd.read_csv(folder / f) for f in ("folds.csv", "regions.csv")]
+        return cb.DesignMap(fw, *tables, rec, tuple(rec["axes"])), False
     m = cb.design_map(fw, "x", WINDOW["x"], "y", WINDOW["y"], points=N, workers=2)
-    return m, request.param == "zeeman_cables"
+    return m, True
 
 
 def test_zeeman_regions_match_a_scan_of_the_energy(zeeman_map):
@@ -123,8 +143,6 @@ def test_zeeman_map_cusps_and_folds(zeeman_map):
 
 # ---- the command line ---------------------------------------------------------------------
 
-ZEEMAN_ARGS = ("map", "--framework", f"{EXAMPLES}/zeeman.toml", "--quiet")
-
 
 @pytest.mark.parametrize(
     ("args", "named"),
@@ -144,25 +162,25 @@ def test_map_framework_refuses_bad_input_in_one_line(tmp_path, args, named):
     assert not (tmp_path / "m").exists() or not any((tmp_path / "m").iterdir())
 
 
-def test_map_framework_writes_the_map(tmp_path):
-    window = ("--param", "x", "--from", "-0.6", "--to", "0.8",
-              "--param2", "y", "--from2", "-0.8", "--to2", "0.2", "--points", "7")  # fmt: skip
-    run = run_cli(*ZEEMAN_ARGS, *window, "--workers", "1", "--out", str(tmp_path))
-    assert run.returncode == 0, run.stderr
-    folder = (tmp_path / "latest").resolve()
+def test_map_framework_writes_the_map(zeeman_cli):
+    run, folder = zeeman_cli
     regions = pd.read_csv(folder / "regions.csv")
-    assert list(regions.columns) == ["x", "y", "physical", "stable"] and len(regions) == 49
+    assert list(regions.columns) == ["x", "y", "physical", "stable"] and len(regions) == N * N
     folds = pd.read_csv(folder / "folds.csv")
     for col in ("x", "y", "wheel.angle_deg", "curve_id", "arc", "kind", "changes_stable_count"):
         assert col in folds.columns
     rec = json.loads((folder / "run.json").read_text())
-    assert rec["window"] == {"x": [-0.6, 0.8], "y": [-0.8, 0.2]} and rec["points"] == 7
+    assert rec["window"] == {"x": [-0.6, 0.8], "y": [-0.8, 0.2]} and rec["points"] == N
     assert rec["framework"] == "zeeman" and rec["unexplained_changes"] == 0
     assert {"folds", "regions"} <= set(rec["timings"]) and rec["fold_record"]
+    assert {"map", "--framework", "--points"} <= set(rec["command"])
     assert (folder / "map.png").is_file() and (folder / "sweep" / "sweep.csv").is_file()
+    assert "framework_folds" not in (folder / "columns.md").read_text()  # titles, not keys
+    assert "folds.csv of a framework's map" in (folder / "columns.md").read_text()
     line = next(ln for ln in run.stdout.splitlines() if ln.startswith("map:"))
     assert "in the window x -0.6..0.8, y -0.8..0.2" in line
     assert f"{len(folds)} fold points" in line
+    assert f"{rec['count_changes']}, 0 not explained" in run.stdout
 
 
 # ---- make stress: the completeness check on two-body and closed-loop frameworks --------------

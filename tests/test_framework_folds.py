@@ -185,3 +185,38 @@ def test_bad_axes_are_refused():
         framework_fold_curves(fw, "z", (0, 1), "y", (0, 1))
     with pytest.raises(ParameterError, match="^x: window"):
         framework_fold_curves(fw, "x", (1, 0), "y", (0, 1))
+
+
+def _cable_minima(u, n: int = 20000) -> int:
+    t = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
+    h = 1e-5
+    g = (zeeman_energy(t + h, u, True) - zeeman_energy(t - h, u, True)) / (2 * h)
+    return int(((g < 0) & (np.roll(g, -1) >= 0)).sum())
+
+
+def test_zeeman_cables_switch_curve_against_a_scan():
+    """Points of the cable-switch curves: at their (x, y) a dense scan of the independent cable
+    energy has an equilibrium at the row's wheel angle where the band is exactly at its free
+    length; the stable count on both sides of the curve agrees with changes_stable_count."""
+    fw = cb.Framework.from_toml(EXAMPLES / "zeeman_cables.toml")
+    table, record = framework_fold_curves(
+        fw, "x", ZEEMAN_WINDOW[0], "y", ZEEMAN_WINDOW[1], kinds=("cable_switch",)
+    )
+    assert record["kinds"] == ["cable_switch"] and set(table["kind"]) == {"cable_switch"}
+    assert len(table) > 100 and table["physical"].all()
+    rows = table.sort_values(["curve_id", "arc"]).reset_index(drop=True)
+    for k in range(1, len(rows) - 1, max(1, len(rows) // 8)):
+        row = rows.iloc[k]
+        u = (row["x"], row["y"])
+        crit = scan_critical_points(lambda t, u=u: zeeman_energy(t, u, True))
+        theta = np.radians(row["wheel.angle_deg"])
+        gap = [abs(np.angle(np.exp(1j * (t - theta)))) for t, _ in crit]
+        t_scan = crit[int(np.argmin(gap))][0]
+        assert min(gap) < 1e-6
+        rim = np.array([1.0 + 0.5 * np.cos(t_scan), 0.5 * np.sin(t_scan)])
+        assert abs(np.hypot(*(rim - np.array(u))) - 0.25) < 1e-6
+        xy = rows[["x", "y"]].to_numpy()
+        tangent = xy[k + 1] - xy[k - 1]
+        step = 2e-3 * np.array([-tangent[1], tangent[0]]) / np.linalg.norm(tangent)
+        change = abs(_cable_minima(tuple(xy[k] + step)) - _cable_minima(tuple(xy[k] - step)))
+        assert change == (1 if row["changes_stable_count"] else 0)

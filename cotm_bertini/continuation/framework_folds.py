@@ -61,12 +61,16 @@ def framework_fold_curves(
     yname: str,
     yrange: tuple[float, float],
     settings: Settings | None = None,
+    kinds: tuple[str, ...] = ("fold", "cable_switch"),
 ) -> tuple[pd.DataFrame, dict]:
     """Fold curves, cusps and cable switches of `fw` in the window xrange x yrange of its
     parameters xname, yname: one row a point (docs/columns.md, "framework folds") and the record
-    for run.json."""
+    for run.json. `kinds`: which curves to compute (fold curves bring their cusps)."""
     settings = settings or Settings()
     _check(fw, xname, xrange, yname, yrange)
+    for kind in kinds:
+        if kind not in ("fold", "cable_switch"):
+            raise ParameterError(f"kinds: {kind!r} is not a curve kind (fold, cable_switch)")
     from ..point import taut_sets
 
     t0 = time.perf_counter()
@@ -77,7 +81,8 @@ def framework_fold_curves(
         if framework_system(centre, taut).free:
             continue  # moves freely: no isolated equilibria, so no folds (continuum_check's job)
         cables = [c for c in taut if normalized_slots(centre)[f"L0_{c}"] != 0]
-        for cable in ["", *cables]:
+        chosen = ([""] if "fold" in kinds else []) + (cables if "cable_switch" in kinds else [])
+        for cable in chosen:
             cs = curve_system(centre, taut, xname, yname, cable)
             curves, info = _find(fw, cs, (xname, xrange), (yname, yrange), settings)
             frame, next_id, about = _rows(fw, curves, xname, yname, next_id)
@@ -87,6 +92,7 @@ def framework_fold_curves(
     table = pd.concat(frames, ignore_index=True) if frames else _empty(fw, xname, yname)
     record.update(
         window={xname: list(xrange), yname: list(yrange)}, spacing=SPACING, lines=LINES,
+        kinds=list(kinds),
         seed=settings.seed, seconds=time.perf_counter() - t0,
         counts={k: int((table["kind"] == k).sum()) for k in ("fold", "cusp", "cable_switch")},
         curves_found=int(table.loc[table["curve_id"] >= 0, "curve_id"].nunique()),

@@ -28,8 +28,10 @@ phcpack:
 case1 case2 case3: $(STAMP)
 	$(CLI) solve $@ --engine cli
 
+# Two pytest-xdist workers (the CI machine's 2 cores); the costly framework examples share one
+# worker (xdist_group) and every worker one fresh cache, so each generic set is solved once.
 test: $(STAMP) phcpack
-	$(BIN)/pytest -q -m "not slow"
+	$(BIN)/pytest -q -m "not slow" -n 2 --dist loadgroup
 
 verify: $(STAMP) phcpack
 	$(CLI) verify case1 && $(CLI) verify case2 && $(CLI) verify case3

@@ -17,11 +17,15 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 def pytest_configure(config):
     """One fresh cache for the whole session (generic solution sets and solves): tests never
-    read a cache left by an earlier run or by a user, and child processes inherit it."""
+    read a cache left by an earlier run or by a user, and child processes inherit it. Under
+    pytest-xdist the workers inherit the controller's, so a generic set is solved once."""
     import os
     import tempfile
 
+    if os.environ.get("PYTEST_XDIST_WORKER") and os.environ.get("COTM_TEST_SESSION_CACHE"):
+        return
     os.environ["COTM_CACHE"] = tempfile.mkdtemp(prefix="cotm-test-cache-")
+    os.environ["COTM_TEST_SESSION_CACHE"] = "1"
 
 
 @cache

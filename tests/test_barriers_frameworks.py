@@ -24,6 +24,10 @@ from framework_physics import (
 import cotm_bertini as cb
 from cotm_bertini.errors import ParameterError
 
+# These share the cold generic sets of the costly examples (fourbar, double pendulum,
+# cotm.toml): one xdist worker runs them in turn, so each set is solved once.
+pytestmark = pytest.mark.xdist_group("framework_examples")
+
 EXAMPLES = ROOT / "examples"
 BISTABLE = (0.1, -0.25)  # u = (x, y) inside Zeeman's diamond: two minima, for springs and cables
 

@@ -23,6 +23,10 @@ from physics import mp_refine
 import cotm_bertini as cb
 from cotm_bertini.errors import ParameterError
 
+# These share the cold generic sets of the costly examples (fourbar, double pendulum,
+# cotm.toml): one xdist worker runs them in turn, so each set is solved once.
+pytestmark = pytest.mark.xdist_group("framework_examples")
+
 EXAMPLES = ROOT / "examples"
 
 

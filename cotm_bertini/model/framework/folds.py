@@ -28,6 +28,7 @@ from functools import cache
 from pathlib import Path
 
 import sympy as sp
+from sympy.polys.matrices import DomainMatrix
 
 from ...errors import ParameterError
 from ...fs import atomic_write_text, cache_root, files_hash
@@ -164,7 +165,10 @@ def fold_condition(fw: Framework, taut: tuple[str, ...]) -> sp.Expr:
         H[j, i] = H[i, j]
     G = sp.Matrix([[sp.diff(g, a).subs(at) for a in local] for g, *_ in cons])
     B = H if not len(cons) else sp.Matrix(sp.BlockMatrix([[H, G.T], [G, sp.zeros(len(cons))]]))
-    det = sp.expand(B.det(method="berkowitz"))
+    # Over the polynomial ring (fraction-free Bareiss): sympy's Matrix.det simplifies every
+    # product and takes minutes on two bodies.
+    dm = DomainMatrix.from_Matrix(B)
+    det = sp.expand(dm.domain.to_sympy(dm.det()))
     out = sp.Integer(0)
     for monomial, coeff in sp.Poly(det, *alphas).terms() if alphas else [((), det)]:
         factor = sp.Integer(1)

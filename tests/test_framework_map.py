@@ -18,6 +18,8 @@ import cotm_bertini as cb
 from cotm_bertini.analysis.region_changes import count_changes, unexplained
 from cotm_bertini.api.maps import grid_values
 
+pytestmark = pytest.mark.xdist_group("framework_examples")  # the Zeeman fold sets: solved once
+
 EXAMPLES = "examples"
 WINDOW = {"x": (-0.6, 0.8), "y": (-0.8, 0.2)}  # the window: Zeeman's diamond inside
 N = 21  # grid points a side in make test

@@ -55,7 +55,7 @@ stress: $(STAMP) phcpack
 	  tests/test_barriers_frameworks.py::test_spatial_top_barrier_against_the_closed_form \
 	  tests/test_scaleout.py::test_double_pendulum_generic_set_split_equals_bertinis \
 	  tests/test_scaleout.py::test_paper_generic_set_split_equals_bertinis \
-	  tests/test_framework_map.py::test_map_count_changes_are_explained_stress \
+	  tests/test_framework_map.py \
 	  tests/test_framework_folds.py
 
 bench: $(STAMP) phcpack

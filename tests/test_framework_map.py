@@ -110,6 +110,7 @@ def zeeman_map(request):
     return m, True
 
 
+@pytest.mark.slow  # the Zeeman fold witness sets, solved cold: minutes (make stress)
 def test_zeeman_regions_match_a_scan_of_the_energy(zeeman_map):
     m, cables = zeeman_map
     regions = m.regions
@@ -121,6 +122,7 @@ def test_zeeman_regions_match_a_scan_of_the_energy(zeeman_map):
     assert set(regions.stable) == {1, 2}  # the bistable diamond, and the rest
 
 
+@pytest.mark.slow  # the Zeeman fold witness sets, solved cold: minutes (make stress)
 def test_zeeman_map_count_changes_are_explained(zeeman_map):
     m, cables = zeeman_map
     rec = m.record
@@ -134,6 +136,7 @@ def test_zeeman_map_count_changes_are_explained(zeeman_map):
     assert len(unexplained(m.regions, bare, "x", "y")[0]) == rec["count_changes"]
 
 
+@pytest.mark.slow  # the Zeeman fold witness sets, solved cold: minutes (make stress)
 def test_zeeman_map_cusps_and_folds(zeeman_map):
     m, _ = zeeman_map
     folds = m.folds
@@ -164,6 +167,7 @@ def test_map_framework_refuses_bad_input_in_one_line(tmp_path, args, named):
     assert not (tmp_path / "m").exists() or not any((tmp_path / "m").iterdir())
 
 
+@pytest.mark.slow  # the Zeeman fold witness sets, solved cold: minutes (make stress)
 def test_map_framework_writes_the_map(zeeman_cli):
     run, folder = zeeman_cli
     regions = pd.read_csv(folder / "regions.csv")

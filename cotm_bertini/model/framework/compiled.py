@@ -46,20 +46,13 @@ def framework_system(fw: Framework, taut: tuple[str, ...]) -> FrameworkSystem:
     key = structure_key(fw, taut)
     if key in _LOADED:
         return _LOADED[key]
-    path = cache_root() / "frameworks" / f"system-{key}.json"
-    derived = None
-    if path.is_file():
-        try:
-            derived = Derived(**json.loads(path.read_text()))
-        except (ValueError, TypeError):
-            derived = None  # damaged: derive again
-    if derived is None:
+
+    def fresh() -> Derived:
         from .derive import derive
 
-        derived = derive(fw, tuple(sorted(taut)))
-        atomic_write_text(path, json.dumps(asdict(derived)))
-    module = types.ModuleType(f"cotm_framework_{key}")
-    exec(compile(derived.source, str(path), "exec"), module.__dict__)
+        return derive(fw, tuple(sorted(taut)))
+
+    derived, module = cached_derivation(f"system-{key}", Derived, fresh)
     out = FrameworkSystem(
         key, tuple(sorted(taut)), ParametricSystem.from_json(derived.system),
         tuple(derived.kinds), tuple(derived.descriptions), tuple(derived.free),
@@ -69,6 +62,24 @@ def framework_system(fw: Framework, taut: tuple[str, ...]) -> FrameworkSystem:
     )  # fmt: skip
     _LOADED[key] = out
     return out
+
+
+def cached_derivation(name: str, kind: type, derive) -> tuple:
+    """A derivation (dataclass `kind` with generated `source`) from the disk cache, or derived
+    and stored; with its generated code compiled into a module: (data, module)."""
+    path = cache_root() / "frameworks" / f"{name}.json"
+    data = None
+    if path.is_file():
+        try:
+            data = kind(**json.loads(path.read_text()))
+        except (ValueError, TypeError):
+            data = None  # damaged: derive again
+    if data is None:
+        data = derive()
+        atomic_write_text(path, json.dumps(asdict(data)))
+    module = types.ModuleType(f"cotm_{name.replace('-', '_')}")
+    exec(compile(data.source, str(path), "exec"), module.__dict__)
+    return data, module
 
 
 def variable_groups(fs: FrameworkSystem) -> list[list[str]]:

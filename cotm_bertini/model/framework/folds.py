@@ -31,9 +31,9 @@ import sympy as sp
 from sympy.polys.matrices import DomainMatrix
 
 from ...errors import ParameterError
-from ...fs import atomic_write_text, cache_root, files_hash
+from ...fs import files_hash
 from ..polynomial import ParametricSystem
-from .compiled import framework_system, variable_groups
+from .compiled import cached_derivation, framework_system, variable_groups
 from .expressions import Expr
 from .spec import Framework
 from .structure import source_hash, structure_key
@@ -249,18 +249,9 @@ def curve_system(
     key = curve_key(fw, taut, xname, yname, cable)
     if key in _LOADED:
         return _LOADED[key]
-    path = cache_root() / "frameworks" / f"curve-{key}.json"
-    data = None
-    if path.is_file():
-        try:
-            data = CurveDerived(**json.loads(path.read_text()))
-        except (ValueError, TypeError):
-            data = None  # damaged: derive again
-    if data is None:
-        data = CurveDerived(**_derive(fw, taut, xname, yname, cable))
-        atomic_write_text(path, json.dumps(asdict(data)))
-    module = types.ModuleType(f"cotm_curve_{key}")
-    exec(compile(data.source, str(path), "exec"), module.__dict__)
+    data, module = cached_derivation(
+        f"curve-{key}", CurveDerived, lambda: CurveDerived(**_derive(fw, taut, xname, yname, cable))
+    )
     groups = [*variable_groups(framework_system(fw, taut)), ["tline"]]
     out = CurveSystem(
         key, taut, data.kind, data.cable, tuple(data.variables),

@@ -256,8 +256,10 @@ def _secant(warm: WarmStart, params: Params) -> np.ndarray | None:
 
 
 def _newton(system, x: np.ndarray) -> tuple[np.ndarray | None, np.ndarray]:
-    """Newton's method on every point until its step is below _CONVERGED (relative), at most
-    NEWTON_ITERATIONS times; only the points not yet converged are iterated."""
+    """Newton's method on every point until its step is below _CONVERGED (relative), or below
+    _ACCEPTED and no longer halving (rounding: a root whose Jacobian is conditioned 1e4 never
+    reaches _CONVERGED), at most NEWTON_ITERATIONS times; only the points not yet done are
+    iterated."""
     size = np.full(len(x), np.inf)
     active = np.arange(len(x))
     with np.errstate(all="ignore"):
@@ -269,8 +271,11 @@ def _newton(system, x: np.ndarray) -> tuple[np.ndarray | None, np.ndarray]:
                 return None, size
             xa = xa - step[..., 0]
             x[active] = xa
+            before = size[active]
             size[active] = np.abs(step[..., 0]).max(axis=1) / (1 + np.abs(xa).max(axis=1))
-            keep = ~(size[active] < _CONVERGED)  # NaN stays active, and then fails the check
+            now = size[active]
+            done = (now < _CONVERGED) | ((now < _ACCEPTED) & (now > before / 2))
+            keep = ~done  # NaN stays active, and then fails the check
             if not keep.any() or not np.isfinite(size[active]).all():
                 break
             active = active[keep]

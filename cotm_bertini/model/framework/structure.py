@@ -115,10 +115,16 @@ def source_hash() -> str:
     return files_hash(_SOURCES)
 
 
-@lru_cache(maxsize=256)
 def structure_key(fw: Framework, taut: tuple[str, ...]) -> str:
     """Content hash of a structure and the derivation code."""
-    blob = json.dumps({"s": structure(fw, taut), "code": source_hash()}, sort_keys=True)
+    # Keyed on what the structure depends on (not on every value): a sweep's points share it.
+    return _structure_key(fw.at_defaults(), fw.zero_free_length(), tuple(taut))
+
+
+@lru_cache(maxsize=256)
+def _structure_key(defaults: Framework, zfl: tuple[str, ...], taut: tuple[str, ...]) -> str:
+    s = {**structure(defaults, taut), "zfl": sorted(zfl)}
+    blob = json.dumps({"s": s, "code": source_hash()}, sort_keys=True)
     return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
 

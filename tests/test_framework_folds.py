@@ -36,12 +36,11 @@ def test_fold_condition_vanishes_at_the_scanned_folds_only():
     """The fold system's extra equation (the bordered Hessian's determinant cleared of 1/d),
     evaluated at the double roots of the independent V' along x = 0.1 and at its ordinary
     critical points: zero at the first, not at the second. Cheap: no Bertini solve."""
-    from cotm_bertini.model.framework.folds import curve_system, parameter_values
+    from cotm_bertini.model.framework.folds import curve_system
     from cotm_bertini.model.framework.units import units
 
     fw = cb.Framework.from_toml(EXAMPLES / "zeeman.toml").replace(x=0.1, y=-0.3)
     cs = curve_system(fw, (), "x", "y")
-    P = np.array([parameter_values(cs, fw)[n] for n in cs.params])
     L, K = units(fw)
 
     def fold_value(theta: float, u) -> tuple[float, float]:
@@ -51,7 +50,7 @@ def test_fold_condition_vanishes_at_the_scanned_folds_only():
             d = np.hypot(*(rim - anchor))
             X[f"d_{band}"], X[f"w_{band}"] = d / L, (1.0 - 0.25 / d) / K
         z = np.array([X[v] for v in cs.variables] + [u[0] / cs.scales[0], u[1] / cs.scales[1]])
-        res = np.array([float(r) for r in cs.numeric.residual(z, P)])
+        res = np.array([float(r) for r in cs.numeric.residual(z)])
         return float(np.abs(res[:-1]).max()), float(abs(res[-1]))
 
     folds = _scanned_folds_along_x(0.1)
@@ -220,3 +219,43 @@ def test_zeeman_cables_switch_curve_against_a_scan():
         step = 2e-3 * np.array([-tangent[1], tangent[0]]) / np.linalg.norm(tangent)
         change = abs(_cable_minima(tuple(xy[k] + step)) - _cable_minima(tuple(xy[k] - step)))
         assert change == (1 if row["changes_stable_count"] else 0)
+
+
+@pytest.mark.slow  # cotm.toml's fold witness set: minutes cold (see docs/design.md)
+def test_cotm_toml_folds_lie_on_the_closed_form_curves():
+    """The fold curves of examples/cotm.toml by the Bertini route, over the paper's window
+    (0, 14]^2, against the built-in closed form (analysis/fold_curves.py: the parallel curve and
+    the quadratic det H(t)), which shares no code with the framework route: every Bertini fold
+    point has its pose on the parallel curve and its free lengths those the closed form gives at
+    that pose (1e-6 relative), and every closed-form fold point in the window is within the
+    polyline spacing of a Bertini one."""
+    from cotm_bertini.analysis.design import generalised_forces, parallel_cross
+    from cotm_bertini.analysis.fold_curves import fold_curves, tensioned_free_lengths
+
+    p = cb.Params.case("case3")
+    fw = cb.Framework.from_toml(EXAMPLES / "cotm.toml")
+    window = (1e-9, 14.0)
+    table, record = framework_fold_curves(fw, "L01", window, "L02", window, kinds=("fold",))
+    assert all(r["lost_paths"] == 0 for ts in record["taut_sets"].values() for r in ts.values())
+    folds = table[table["physical"].astype(bool) & (table["kind"] == "fold")]
+    assert len(folds) > 500
+    g1, g2 = np.radians(folds["rod.angle_deg"].to_numpy()), np.radians(folds["top.angle_deg"])
+    g2 = g2.to_numpy()
+    ours = folds[["L01", "L02"]].to_numpy().T
+    # On the parallel curve: a_1 x a_2 = 0, relative to |a_1| |a_2|.
+    a, d = generalised_forces(p, g1, g2)
+    scale = np.hypot(*a[0]) * np.hypot(*a[1])
+    assert (np.abs(parallel_cross(p, g1, g2)) <= 1e-6 * scale).all()
+    # Free lengths: the tensioned fold's (t = -c1/c2) or the relaxed one's (L0 = d, t = 0).
+    tensioned = tensioned_free_lengths(p, g1, g2)
+    gap = np.minimum(np.abs(ours - tensioned).max(axis=0), np.abs(ours - d).max(axis=0))
+    assert (gap <= 1e-6 * np.abs(ours).max(axis=0)).all()
+    # The reverse: every closed-form fold point in the window near a Bertini one.
+    closed = fold_curves(p)
+    closed = closed[closed["physical"] & (closed["kind"] == "fold")
+                    & closed["L01"].between(*window) & closed["L02"].between(*window)]  # fmt: skip
+    assert len(closed) > 500
+    spacing = SPACING * np.hypot(14.0, 14.0)
+    c = closed[["L01", "L02"]].to_numpy()
+    nearest = np.sqrt(((c[:, None, :] - ours.T[None, :, :]) ** 2).sum(axis=2)).min(axis=1)
+    assert nearest.max() <= spacing, closed.iloc[int(np.argmax(nearest))].to_dict()

@@ -31,7 +31,7 @@ from ..backends.endpoints import Endpoints
 from ..backends.homotopy import generic_set, track
 from ..errors import ParameterError
 from ..model.framework.compiled import framework_system
-from ..model.framework.folds import LINE, CurveSystem, curve_system, parameter_values
+from ..model.framework.folds import LINE, CurveSystem, curve_system
 from ..model.framework.spec import Framework
 from ..model.framework.units import normalized_slots, units
 from ..settings import Settings, Tolerances
@@ -121,32 +121,32 @@ def _centre(cs: CurveSystem, fw: Framework, xname: str, yname: str) -> dict:
     sx, sy = cs.scales
     line = {LINE[0]: d.values[xname] / sx, LINE[1]: d.values[yname] / sy, LINE[2]: 1.0,
             LINE[3]: 0.7}  # fmt: skip
-    out = {**parameter_values(cs, d), **line}
-    return {n: out[n] for n in cs.ps.parameters}
+    return {n: line[n] for n in cs.ps.parameters}
 
 
-def _equations(cs: CurveSystem, P: np.ndarray):
+def _equations(cs: CurveSystem):
     """The traced equations of z = (X, mx, my): the curve system's residual and Jacobian."""
 
     def eqs(z: np.ndarray, zref: np.ndarray):
-        F = np.array([complex(e).real for e in cs.numeric.residual(z, P)])
-        J = np.array([complex(e).real for e in cs.numeric.jacobian(z, P)]).reshape(len(F), len(z))
+        F = np.array([complex(e).real for e in cs.numeric.residual(z)])
+        J = np.array([complex(e).real for e in cs.numeric.jacobian(z)]).reshape(len(F), len(z))
         return F, J
 
     return eqs
 
 
-def _line_seeds(cs, gs, centre, base, win: Window, settings) -> tuple[list, list[dict]]:
+def _line_seeds(cs, gs, win: Window, settings) -> tuple[list, list[dict]]:
     """Real points of the curve on LINES vertical and LINES horizontal lines of the window."""
     seeds, lines = [], []
     (xl, yl), (xh, yh) = win.lo, win.hi
     specs = [(xv, yl, 0.0, yh - yl) for xv in np.linspace(xl, xh, LINES)]
     specs += [(xl, yv, xh - xl, 0.0) for yv in np.linspace(yl, yh, LINES)]
     for x0, y0, dx, dy in specs:
-        target = {**base, LINE[0]: x0, LINE[1]: y0, LINE[2]: dx, LINE[3]: dy}
-        # Straight from the witness set, no fallback: on a line parallel to an axis the curve
-        # system's degree in tline drops, so paths going to infinity are expected, not a failure.
-        ends, rep = track(cs.ps, gs, target, settings)
+        target = {LINE[0]: x0, LINE[1]: y0, LINE[2]: dx, LINE[3]: dy}
+        # Straight from the witness set, no fallback: on a real line some paths go to infinity
+        # (on every line tried, axis-parallel or not), which is expected, not a failure. A seed
+        # is a point of order one, so a path that diverges in double precision is not retracked.
+        ends, rep = track(cs.ps, gs, target, settings, retrack_diverged=False)
         pts = ends.points
         real = (np.abs(pts.imag) / (1 + np.abs(pts.real))).max(axis=1) < 1e-6 if len(pts) else []
         found = 0
@@ -171,11 +171,9 @@ def _find(fw: Framework, cs: CurveSystem, xaxis, yaxis, settings) -> tuple[_Curv
     nz = len(cs.variables)
     win = Window(nz, nz + 1, (xrange[0] / sx, yrange[0] / sy), (xrange[1] / sx, yrange[1] / sy),
                  (sx, sy))  # fmt: skip
-    P = np.array([parameter_values(cs, fw)[n] for n in cs.params])
-    base = {n: v for n, v in parameter_values(cs, fw).items() if n in cs.ps.parameters}
-    seeds, lines = _line_seeds(cs, gs, centre, base, win, settings)
+    seeds, lines = _line_seeds(cs, gs, win, settings)
     t2 = time.perf_counter()
-    eqs = _equations(cs, P)
+    eqs = _equations(cs)
     traced, skipped = [], 0
     lengths = [k for k, v in enumerate(cs.variables) if v.startswith("d_")]
     for z in seeds:

@@ -12,10 +12,10 @@ units) and two map parameters (x, y) of the file, a curve is F = 0 plus one more
 Each is generated twice from the same sympy expressions: numpy code of the curve's residual and
 Jacobian in Z = (X, mx, my) (mx = x / sx, my = y / sy: the map coordinates in the units of the
 slots they enter) for tracing; and a Bertini system with (mx, my) = (x0, y0) + tline (dx, dy) on a
-line, tline unknown, whose parameters are the line's coefficients and the framework's other
-non-constant slots: solved once at a random complex line (a witness set of the curve), then
-reached on any real line by parameter homotopy. Cached on disk by structure, map parameters and
-curve kind, like compiled.py.
+line, tline unknown, whose parameters are the line's coefficients: solved once at a random
+complex line (a witness set of the curve), then reached on any real line by parameter homotopy.
+The file's other parameters enter as their values (_slot_values). Cached on disk by structure,
+map parameters, curve kind and those values, like compiled.py.
 """
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ from .compiled import cached_derivation, framework_system, variable_groups
 from .expressions import Expr
 from .spec import Framework
 from .structure import source_hash, structure_key
-from .units import scale_of, slot_kind, units
+from .units import normalized_slots, scale_of, slot_kind, units
 
 LINE = ("line_x0", "line_y0", "line_dx", "line_dy")
 
@@ -49,10 +49,9 @@ class CurveDerived:
     kind: str  # "fold" or "switch"
     cable: str  # the cable at its free length (switch), else ""
     variables: list[str]  # X: the equilibrium system's unknowns, in its order
-    system: dict  # ParametricSystem JSON: unknowns X, tline; parameters LINE + `params`
-    params: list[str]  # the other parameters, in the order of the numeric code's P
+    system: dict  # ParametricSystem JSON: unknowns X, tline; parameters LINE
     scales: list[float]  # (sx, sy): user value = scale * map coordinate
-    source: str  # numpy: residual(Z, P), jacobian(Z, P); Z = X, mx, my
+    source: str  # numpy: residual(Z), jacobian(Z); Z = X, mx, my
 
 
 @dataclass(frozen=True, eq=False)
@@ -65,7 +64,6 @@ class CurveSystem:
     cable: str
     variables: tuple[str, ...]
     ps: ParametricSystem
-    params: tuple[str, ...]
     scales: tuple[float, float]
     numeric: types.ModuleType
     groups: list[list[str]]
@@ -102,43 +100,46 @@ def map_scales(fw: Framework, xname: str, yname: str) -> tuple[float, float]:
     return out[0], out[1]
 
 
-def _slot_substitution(fw: Framework, xname: str, yname: str, mx, my) -> tuple[dict, list]:
-    """sympy substitutions of the slots that name a map parameter (normalised units), and the
-    other parameters they name (symbols par_<name>, user values)."""
+def _slot_values(fw: Framework, xname: str, yname: str, mx, my) -> dict:
+    """sympy substitutions of every slot (normalised units): those that name a map parameter as
+    polynomials in (mx, my), with the file's other parameters at their values; the rest as
+    numbers. A curve system is thus derived for the values of the parameters that are not on the
+    map (the determinant of the bordered Hessian, expanded with every geometry slot a symbol, is
+    too large for sympy on two bodies), and derived and solved again if one of them changes."""
     L, K = units(fw)
     sx, sy = map_scales(fw, xname, yname)
-    others: list[str] = []
 
     def symbol(name: str):
         if name == xname:
             return sx * mx
         if name == yname:
             return sy * my
-        if name not in others:
-            others.append(name)
-        return sp.Symbol(f"par_{name}")
+        return sp.Float(fw.values[name], 17)
 
-    subs = {}
+    slots = normalized_slots(fw)
+    out = {}
     for slot, e in fw.slot_expressions().items():
         if e.names() & {xname, yname}:
-            subs[sp.Symbol(slot)] = to_sympy(e, symbol) / scale_of(slot_kind(slot), L, K)
-    return subs, others
+            out[sp.Symbol(slot)] = to_sympy(e, symbol) / scale_of(slot_kind(slot), L, K)
+        else:
+            out[sp.Symbol(slot)] = sp.Float(slots[slot], 17)
+    return out
 
 
 def _upper(m: int) -> list[tuple[int, int]]:
     return [(i, j) for i in range(m) for j in range(i, m)]
 
 
-def fold_condition(fw: Framework, taut: tuple[str, ...]) -> sp.Expr:
-    """A polynomial in the unknowns and slots that vanishes where the bordered Hessian of the
-    Lagrangian (local coordinates, constraints bordering it) is singular: a fold.
+def fold_condition(fw: Framework, taut: tuple[str, ...], values: dict) -> sp.Expr:
+    """A polynomial in the unknowns that vanishes where the bordered Hessian of the Lagrangian
+    (local coordinates, constraints bordering it) is singular: a fold. `values`: every slot's
+    substitution (_slot_values), made in the entries before the determinant is expanded.
 
     A spring's energy k/2 (|r| - L0)^2 has second derivatives w (r_i . r_j + r . r_ij) +
     alpha (r . r_i)(r . r_j) with w = k (1 - L0/d) and alpha = k L0 / d^3 = (k - w) / d^2. The
     determinant is affine in each alpha (each enters a rank-one term), so multiplying it by every
     d^2 clears the denominators: alpha -> k - w in a term that has it, else a factor d^2."""
     from .derive import _active, local_frame
-    from .units import constants
 
     local, at, pos, cons, loads = local_frame(fw)
     zfl, m = set(fw.zero_free_length()), len(local)
@@ -165,6 +166,8 @@ def fold_condition(fw: Framework, taut: tuple[str, ...]) -> sp.Expr:
         H[j, i] = H[i, j]
     G = sp.Matrix([[sp.diff(g, a).subs(at) for a in local] for g, *_ in cons])
     B = H if not len(cons) else sp.Matrix(sp.BlockMatrix([[H, G.T], [G, sp.zeros(len(cons))]]))
+    # Numbers first: the determinant's size grows with every symbol left in its entries.
+    B = B.applyfunc(lambda e: sp.expand(e.xreplace(values)))
     # Over the polynomial ring (fraction-free Bareiss): sympy's Matrix.det simplifies every
     # product and takes minutes on two bodies.
     dm = DomainMatrix.from_Matrix(B)
@@ -173,10 +176,9 @@ def fold_condition(fw: Framework, taut: tuple[str, ...]) -> sp.Expr:
     for monomial, coeff in sp.Poly(det, *alphas).terms() if alphas else [((), det)]:
         factor = sp.Integer(1)
         for e, (has, lacks) in zip(monomial, laws, strict=True):
-            factor *= has if e else lacks
+            factor *= (has if e else lacks).xreplace(values)
         out += coeff * factor
-    const = {sp.Symbol(n): sp.Float(v, 17) for n, v in constants(fw).items()}
-    return sp.expand(out.xreplace(const))
+    return sp.expand(out)
 
 
 def _derive(fw: Framework, taut: tuple[str, ...], xname: str, yname: str, cable: str) -> dict:
@@ -187,15 +189,16 @@ def _derive(fw: Framework, taut: tuple[str, ...], xname: str, yname: str, cable:
     names, _, F, _ = equilibrium_equations(fw, taut)
     X = [sp.Symbol(n) for n in names]
     mx, my, t = sp.symbols("map_x map_y tline")
-    subs, _ = _slot_substitution(fw, xname, yname, mx, my)
+    values = _slot_values(fw, xname, yname, mx, my)
     extra = (
-        sp.Symbol(f"d_{cable}") - sp.Symbol(f"L0_{cable}") if cable else fold_condition(fw, taut)
+        sp.Symbol(f"d_{cable}") - sp.Symbol(f"L0_{cable}")
+        if cable
+        else fold_condition(fw, taut, values)
     )
-    G = [sp.expand(g.xreplace(subs)) for g in [*F, extra]]
+    G = [sp.expand(g.xreplace(values)) for g in [*F, extra]]
     Z = [*X, mx, my]
     jac = sp.Matrix(G).jacobian(Z)
-    slots_used = sorted({s.name for g in G for s in g.free_symbols} - {z.name for z in Z})
-    args = {"Z": Z, "P": [sp.Symbol(n) for n in slots_used]}
+    args = {"Z": Z}
     source = "from numpy import sqrt\n\n" + numpy_function("residual", args, G)
     source += numpy_function("jacobian", args, list(jac))
     line = {mx: sp.Symbol(LINE[0]) + t * sp.Symbol(LINE[2]),
@@ -203,7 +206,7 @@ def _derive(fw: Framework, taut: tuple[str, ...], xname: str, yname: str, cable:
     eqs = [sp.expand(g.xreplace(line)) for g in G]
     try:
         ps = parametric_from_sympy((*names, t.name), tuple(f"g{i + 1}" for i in range(len(eqs))),
-                                   tuple(eqs), LINE + tuple(slots_used))  # fmt: skip
+                                   tuple(eqs), LINE)  # fmt: skip
     except sp.PolynomialError as exc:
         raise ParameterError(
             f"{xname}, {yname}: a map parameter enters a number of framework {fw.name!r} "
@@ -215,7 +218,6 @@ def _derive(fw: Framework, taut: tuple[str, ...], xname: str, yname: str, cable:
             cable,
             names,
             ps.to_json(),
-            slots_used,
             list(map_scales(fw, xname, yname)),
             source,
         )  # fmt: skip
@@ -229,10 +231,11 @@ def _code_hash() -> str:
 
 def curve_key(fw: Framework, taut: tuple[str, ...], xname: str, yname: str, cable: str) -> str:
     """Content hash of what a curve system depends on."""
-    exprs = {s: repr(e) for s, e in fw.slot_expressions().items() if e.names() & {xname, yname}}
+    exprs = {s: repr(e) for s, e in fw.slot_expressions().items()}
+    others = {n: v for n, v in fw.values.items() if n not in (xname, yname)}
     blob = json.dumps(
         {"s": structure_key(fw, taut), "map": [xname, yname], "cable": cable, "exprs": exprs,
-         "units": units(fw), "code": _code_hash()}, sort_keys=True,
+         "values": others, "units": units(fw), "code": _code_hash()}, sort_keys=True,
     )  # fmt: skip
     return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
@@ -255,17 +258,8 @@ def curve_system(
     groups = [*variable_groups(framework_system(fw, taut)), ["tline"]]
     out = CurveSystem(
         key, taut, data.kind, data.cable, tuple(data.variables),
-        ParametricSystem.from_json(data.system), tuple(data.params),
+        ParametricSystem.from_json(data.system),
         (data.scales[0], data.scales[1]), module, groups,
     )  # fmt: skip
     _LOADED[key] = out
     return out
-
-
-def parameter_values(cs: CurveSystem, fw: Framework) -> dict[str, float]:
-    """The values of the curve system's non-line parameters at `fw`'s values (slots normalised,
-    par_<name> the user's value)."""
-    from .units import normalized_slots
-
-    slots, values = normalized_slots(fw), fw.values
-    return {n: (values[n[4:]] if n.startswith("par_") else slots[n]) for n in cs.params}

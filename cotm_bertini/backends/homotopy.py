@@ -31,7 +31,12 @@ from ..settings import Settings
 from ..versions import bertini2_version
 from .endpoints import Endpoints
 from .render import render_parameter_homotopy, render_system
-from .start_system import gamma_homotopy_text, linear_product_start
+from .start_system import (
+    bezout_number,
+    gamma_homotopy_text,
+    group_degrees,
+    linear_product_start,
+)
 
 _SUCCESS = "Success"
 DOUBLE_FINAL_TOLERANCE = 1e-8
@@ -203,18 +208,20 @@ def _announce(
     ps: ParametricSystem, seed: int, stored: Path | None, groups=None, scheduler=None
 ) -> None:
     """One line on stderr before a generic solve long enough to be noticed: what, how long."""
-    paths = ps.instantiate([1.0 + 0.1j * k for k in range(len(ps.parameters))]).total_degree
+    system = ps.instantiate([1.0 + 0.1j * k for k in range(len(ps.parameters))])
+    paths = (
+        bezout_number(group_degrees(system, groups), [len(g) for g in groups])
+        if groups
+        else system.total_degree
+    )
     seconds = paths * SECONDS_PER_PATH
     if seconds < ANNOUNCE_SECONDS:
         return
-    # A multihomogeneous start (groups) has fewer paths than the total degree: a bound.
-    bound = "at most " if groups else ""
     where = f"once: kept in {stored} for every later solve" if stored else "not cached"
     how = f", split over the Dask workers at {scheduler}" if scheduler else ""
     print(
         f"cotm-bertini: solving the generic solution set of these equations for seed {seed} "
-        f"({bound}{paths} paths, {'up to' if groups else 'roughly'} {seconds:.0f} s{how}; "
-        f"{where})",
+        f"({paths} paths, roughly {seconds:.0f} s{how}; {where})",
         file=sys.stderr,
         flush=True,
     )

@@ -150,3 +150,47 @@ def gamma_homotopy_text(system: PolySystem, start: LinearProductStart, gamma: co
         lines.append(f"{name} = (1-t)*({f}) + {g}*t*({s});")
     lines.append("END;")
     return "\n".join(lines) + "\n"
+
+
+def bezout_number(degrees: np.ndarray, sizes: list[int]) -> int:
+    """The multihomogeneous Bezout number of a degree matrix (equations, groups) for groups of
+    these sizes: the sum over the ways to give each equation a group, group g given exactly
+    |g| times, of the product of the chosen degrees (by dynamic programming on the room left)."""
+    from functools import cache
+
+    rows = [tuple(int(d) for d in r) for r in np.asarray(degrees)]
+
+    @cache
+    def ways(i: int, room: tuple[int, ...]) -> int:
+        if i == len(rows):
+            return 1
+        total = 0
+        for g, d in enumerate(rows[i]):
+            if d and room[g]:
+                total += d * ways(i + 1, room[:g] + (room[g] - 1,) + room[g + 1 :])
+        return total
+
+    return ways(0, tuple(sizes))
+
+
+def fewest_paths_groups(system: PolySystem, groups: list[list[str]]) -> list[list[str]]:
+    """`groups`, or a coarser grouping with fewer multihomogeneous paths: two groups merged at a
+    time while a merge lowers the Bezout number (greedy; the count is combinatorial, no
+    solve). On a two-body fold system (cotm.toml) 2,688 paths become 1,408."""
+    groups = [list(g) for g in groups]
+
+    def paths(gs: list[list[str]]) -> int:
+        return bezout_number(group_degrees(system, gs), [len(g) for g in gs])
+
+    best = paths(groups)
+    while len(groups) > 1:
+        merged = [
+            [g for k, g in enumerate(groups) if k not in (i, j)] + [groups[i] + groups[j]]
+            for i in range(len(groups))
+            for j in range(i + 1, len(groups))
+        ]
+        count, choice = min(((paths(m), m) for m in merged), key=lambda t: t[0])
+        if count >= best:
+            break
+        best, groups = count, choice
+    return groups

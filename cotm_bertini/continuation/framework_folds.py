@@ -29,6 +29,7 @@ from ..analysis.framework_classify import (
 )
 from ..backends.endpoints import Endpoints
 from ..backends.homotopy import generic_set, track
+from ..backends.start_system import fewest_paths_groups
 from ..errors import ParameterError
 from ..model.framework.compiled import framework_system
 from ..model.framework.folds import LINE, CurveSystem, curve_system
@@ -165,7 +166,7 @@ def _find(fw: Framework, cs: CurveSystem, xaxis, yaxis, settings) -> tuple[_Curv
     (xname, xrange), (yname, yrange) = xaxis, yaxis
     t0 = time.perf_counter()
     centre = _centre(cs, fw, xname, yname)
-    gs = generic_set(cs.ps, settings.seed, centre=centre, groups=cs.groups)
+    gs = generic_set(cs.ps, settings.seed, centre=centre, groups=_groups(cs, settings.seed))
     t1 = time.perf_counter()
     sx, sy = cs.scales
     nz = len(cs.variables)
@@ -190,6 +191,14 @@ def _find(fw: Framework, cs: CurveSystem, xaxis, yaxis, settings) -> tuple[_Curv
         "lost_paths": int(sum(ln["lost"] for ln in lines)),
     }  # fmt: skip
     return _Curves(cs, traced, win, eqs), info
+
+
+def _groups(cs: CurveSystem, seed: int) -> list[list[str]]:
+    """The witness set's variable groups: the equilibrium system's plus tline, merged where that
+    lowers the path count (the degree structure read at random complex line coefficients)."""
+    rng = np.random.default_rng(seed)
+    line = rng.normal(size=len(cs.ps.parameters)) + 1j * rng.normal(size=len(cs.ps.parameters))
+    return fewest_paths_groups(cs.ps.instantiate(line), cs.groups)
 
 
 def _on(points: np.ndarray, z: np.ndarray, win: Window, nx: int) -> bool:

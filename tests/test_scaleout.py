@@ -165,6 +165,21 @@ def test_bezout_number_and_fewer_paths_by_merging_groups():
     assert count(chosen) < count(cs.groups)
 
 
+def test_generic_set_with_groups_out_of_variable_order_solves_the_system():
+    """Bertini orders the variables group by group: with groups whose concatenation is not the
+    system's variable order (a merged group, as fewest_paths_groups makes), the generic set's
+    points are still in the system's order, so they solve it at the start parameters."""
+    fw = cb.Framework.from_toml(ROOT / "examples" / "zeeman.toml")
+    fs = framework_system(fw, ())
+    groups = variable_groups(fs)[::-1]
+    groups = [groups[0] + groups[-1], *groups[1:-1]]
+    assert [v for g in groups for v in g] != list(fs.ps.variables)
+    gs = homotopy.generic_set(fs.ps, 7, centre=_centre(fw, fs), groups=groups, use_cache=False)
+    system = fs.ps.instantiate([gs.start[n] for n in fs.ps.parameters])
+    assert len(gs.points) > 0
+    assert np.abs(system.evaluate(gs.points)).max() < 1e-8
+
+
 def _centre(fw, fs) -> dict:
     from cotm_bertini.model.framework.units import normalized_slots
 

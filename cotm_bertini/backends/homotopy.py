@@ -47,6 +47,7 @@ SECONDS_PER_PATH = 0.06  # an ab-initio path of the generic solve (case 3: 192 p
 ANNOUNCE_SECONDS = 2.0  # a generic solve expected to take longer is announced on stderr
 CHUNKS_PER_WORKER = 4  # a split generic solve sends this many chunks of paths per Dask worker
 INFINITE_CODES = ("GoingToInfinity", "SecurityMaxNormReached")
+NEVER_TRACKED = ("NeverStarted", "SingularStartPoint")  # lost, whatever the point's norm
 # Every generic set cached before the route was recorded was solved by Bertini's own start.
 EARLIER_ROUTE = {"method": "bertini start system (ZeroDimSolver), one call"}
 
@@ -274,11 +275,16 @@ def _bertini_solve(system, seed: int, groups) -> tuple[tuple, dict]:
         solver.set(max_num_steps=GENERIC_MAX_STEPS)
     solver.solve(show_progress=True)  # a bar on a terminal after 5 s; silent otherwise
     meta, pts = solver.solution_metadata(), solver.all_solutions()
+    points = _end_points(pts, len(system.variables))
+    if groups:
+        # Bertini orders the variables group by group; a merged group breaks our order.
+        declared = [v for g in groups for v in g]
+        points = points[:, [declared.index(v) for v in system.variables]]
     ends = (
         [_code(m) for m in meta],
         [bool(m.is_finite) for m in meta],
         [is_singular(m) for m in meta],
-        _end_points(pts, len(system.variables)),
+        points,
     )
     start = "multihomogeneous" if groups else "total-degree"
     route = {
@@ -552,7 +558,7 @@ def track(
         redo = list(range(n))
         rep.notes.append("path crossing in double precision: all paths re-tracked")
     elif not retrack_diverged:
-        kept = [i for i in redo if meta[i].is_finite]
+        kept = [i for i in redo if meta[i].is_finite or _code(meta[i]) in NEVER_TRACKED]
         if len(kept) < len(redo):
             rep.notes.append(f"{len(redo) - len(kept)} paths diverged in double precision")
         redo = kept
@@ -567,7 +573,7 @@ def track(
         code = _code(m)
         if code == _SUCCESS and m.is_finite:
             rows.append(endpoint_record(i, m, p))
-        elif code in INFINITE_CODES or not m.is_finite:
+        elif code in INFINITE_CODES or (code not in NEVER_TRACKED and not m.is_finite):
             rep.infinite += 1
         else:
             rep.lost += 1
@@ -649,6 +655,6 @@ def ab_initio(
         if m.is_finite and code == _SUCCESS:
             if not is_singular(m):
                 rows.append(endpoint_record(i, m, p))
-        elif code not in INFINITE_CODES and m.is_finite:
+        elif code not in INFINITE_CODES and (m.is_finite or code in NEVER_TRACKED):
             lost += 1
     return Endpoints.from_records(ps.variables, rows), lost

@@ -27,9 +27,14 @@ def main() -> None:
     ap.add_argument("--zeeman-points", type=int, default=101, help="Zeeman map grid a side")
     ap.add_argument("--zeeman-only", action="store_true", help="only the Zeeman map")
     ap.add_argument("--folds-only", action="store_true", help="only the frameworks' fold curves")
+    ap.add_argument(
+        "--with-cotm",
+        action="store_true",
+        help="cotm.toml's fold curves too (its 1,408-path witness set: over an hour cold)",
+    )
     args = ap.parse_args()
     if args.folds_only:
-        framework_folds()
+        framework_folds(args.with_cotm)
         return
     if args.zeeman_only:
         framework_map(args.zeeman_points)
@@ -65,7 +70,7 @@ def main() -> None:
         print(f"  {case}: {len(found.table)} saddles, {len(found.pairs)} pairs, "
               f"{found.seconds:.2f} s")  # fmt: skip
     framework_map(args.zeeman_points)
-    framework_folds()
+    framework_folds(args.with_cotm)
 
 
 def _fold_run(fw, x: str, xr: tuple, y: str, yr: tuple) -> tuple[float, float, dict]:
@@ -78,15 +83,16 @@ def _fold_run(fw, x: str, xr: tuple, y: str, yr: tuple) -> tuple[float, float, d
     return time.perf_counter() - t0, witness, rec
 
 
-def framework_folds() -> None:
+def framework_folds(with_cotm: bool = False) -> None:
     """Fold curves by the Bertini route (continuation/framework_folds.py): Zeeman over the
-    issue's window, and cotm.toml over (0, 14]^2 against the closed-form route's time on the
-    built-in model (target: at most 10 times it), each run twice (the witness sets solved, or
-    loaded from the cache, then in memory)."""
+    issue's window, and with `with_cotm` cotm.toml over (0, 14]^2 against the closed-form
+    route's time on the built-in model (target: at most 10 times it), each run twice (the
+    witness sets solved, or loaded from the cache, then in memory)."""
     from cotm_bertini.analysis.fold_curves import fold_curves_proved
 
-    runs = [("zeeman", "x", (-0.6, 0.8), "y", (-0.8, 0.2)),
-            ("cotm", "L01", (1e-9, 14.0), "L02", (1e-9, 14.0))]  # fmt: skip
+    runs = [("zeeman", "x", (-0.6, 0.8), "y", (-0.8, 0.2))]
+    if with_cotm:
+        runs.append(("cotm", "L01", (1e-9, 14.0), "L02", (1e-9, 14.0)))
     for name, x, xr, y, yr in runs:
         fw = cb.Framework.from_toml(f"examples/{name}.toml")
         first, witness, rec = _fold_run(fw, x, xr, y, yr)

@@ -239,8 +239,8 @@ def test_cotm_toml_folds_lie_on_the_closed_form_curves():
     assert all(r["lost_paths"] == 0 for ts in record["taut_sets"].values() for r in ts.values())
     folds = table[table["physical"].astype(bool) & (table["kind"] == "fold")]
     assert len(folds) > 500
-    g1, g2 = np.radians(folds["rod.angle_deg"].to_numpy()), np.radians(folds["top.angle_deg"])
-    g2 = g2.to_numpy()
+    g1 = np.radians(folds["rod.angle_deg"].to_numpy())
+    g2 = np.radians(folds["top.angle_deg"].to_numpy())
     ours = folds[["L01", "L02"]].to_numpy().T
     # On the parallel curve: a_1 x a_2 = 0, relative to |a_1| |a_2|.
     a, d = generalised_forces(p, g1, g2)

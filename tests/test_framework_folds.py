@@ -50,7 +50,7 @@ def test_fold_condition_vanishes_at_the_scanned_folds_only():
             d = np.hypot(*(rim - anchor))
             X[f"d_{band}"], X[f"w_{band}"] = d / L, (1.0 - 0.25 / d) / K
         z = np.array([X[v] for v in cs.variables] + [u[0] / cs.scales[0], u[1] / cs.scales[1]])
-        res = np.array([float(r) for r in cs.numeric.residual(z)])
+        res = cs.trace.evaluate(z)[0].real
         return float(np.abs(res[:-1]).max()), float(abs(res[-1]))
 
     folds = _scanned_folds_along_x(0.1)
@@ -184,6 +184,32 @@ def test_bad_axes_are_refused():
         framework_fold_curves(fw, "z", (0, 1), "y", (0, 1))
     with pytest.raises(ParameterError, match="^x: window"):
         framework_fold_curves(fw, "x", (1, 0), "y", (0, 1))
+    with pytest.raises(ParameterError, match="^seeds: 'lines' is not a seed route"):
+        framework_fold_curves(fw, "x", (0, 1), "y", (0, 1), seeds="lines")
+
+
+@pytest.mark.slow  # 18 lines of 101 solves each: about a minute
+def test_zeeman_sweep_seeds_find_the_same_diamond():
+    """The seed route from equilibria sampled along the lines (no fold witness set): the same
+    single closed curve with four cusps, each point a double root of the independent V, and
+    its crossings of x = 0.1 where a dense scan puts them."""
+    fw = cb.Framework.from_toml(EXAMPLES / "zeeman.toml")
+    table, record = framework_fold_curves(
+        fw, "x", ZEEMAN_WINDOW[0], "y", ZEEMAN_WINDOW[1], kinds=("fold",), seeds="sweep"
+    )
+    info = record["taut_sets"]["none"]["fold"]
+    assert info["seed_route"] == "sweep" and "generic_set" not in info
+    assert record["curves_found"] == 1 and record["counts"]["cusp"] == 4
+    assert info["ends"] == [["closed", "closed"]] and info["unrefined_brackets"] == 0
+    folds = table[table["kind"] == "fold"].sort_values("arc")
+    theta = np.radians(folds["wheel.angle_deg"].to_numpy())
+    u = (folds["x"].to_numpy(), folds["y"].to_numpy())
+    assert np.abs(_dV(theta, u)).max() < 1e-8 and np.abs(_d2V(theta, u)).max() < 1e-5
+    x, y = u
+    cut = np.flatnonzero(np.sign(x[:-1] - 0.1) != np.sign(x[1:] - 0.1))
+    crossings = y[cut] + (0.1 - x[cut]) * (y[cut + 1] - y[cut]) / (x[cut + 1] - x[cut])
+    scanned = _scanned_folds_along_x(0.1)
+    assert len(crossings) == 2 and np.abs(np.sort(crossings) - np.sort(scanned)).max() < 2e-4
 
 
 def _cable_minima(u, n: int = 20000) -> int:

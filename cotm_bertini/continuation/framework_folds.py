@@ -1,16 +1,28 @@
 """Fold curves, cusps and cable switches of any framework over two of its parameters.
 
-For every taut set: the fold system (model/framework/folds.py) is solved once at a random complex
-line of the (x, y) plane by Bertini (a witness set of the fold curve) and brought to real lines
-across the window (vertical and horizontal, the window's edges among them) by parameter homotopy;
-each real fold point found there seeds a pseudo-arclength trace of its curve in (X, v, x, y)
-(continuation/curve_trace.py) to the window's edge or until it closes, and a seed on a curve
-already traced is skipped. Cusps are where the curve's image in the plane turns back (refined by
-bisection on the image's speed along the incoming direction) and are confirmed by the vanishing
-of w . F_XX[v, v] (w, v the left and right null vectors of J_X F: the cubic term of the energy
-along the null direction). Cable switches (a taut cable exactly at its free length L0 > 0) are
-found and traced the same way on the switch system. Every point is classified by the
-framework's own classification (analysis/framework_classify.py) at its (x, y).
+For every taut set, fold points on real lines across the window (vertical and horizontal, the
+window's edges among them) are found by one of two routes, both Bertini's:
+
+- "witness": the fold system (model/framework/folds.py) is solved once at a random complex line
+  of the (x, y) plane (a witness set of the fold curve) and brought to each real line by
+  parameter homotopy: every fold point on the line;
+- "sweep": the equilibria of the taut set are solved at SWEEP_POINTS points along each line
+  (parameter homotopy from the equilibrium system's generic set, then Newton continuation
+  checked complete, as a sweep does); where the number of real equilibria changes by an even
+  number between neighbours, the interval is bisected until Newton on the fold system, started
+  from the mean of the closest real pair, lands in it. Two folds closer together on a line than
+  its sampling are not seen there. For systems whose witness set is too costly (cotm.toml's:
+  1,408 paths, each slow in Bertini 2 for a 1,226-term fold equation).
+
+"auto" takes the witness route when the witness set's multihomogeneous path count is at most
+WITNESS_MAX_PATHS, else the sweep. Each real fold point found seeds a pseudo-arclength trace of
+its curve in (X, x, y) (continuation/curve_trace.py) to the window's edge or until it closes,
+and a seed on a curve already traced is skipped. Cusps are where the curve's image in the plane
+turns back (refined by bisection on the image's speed along the incoming direction) and are
+confirmed by the vanishing of w . F_XX[v, v] (w, v the left and right null vectors of J_X F: the
+cubic term of the energy along the null direction). Cable switches (a taut cable exactly at its
+free length L0 > 0) are found and traced the same way on the switch system. Every point is
+classified by the framework's own classification (analysis/framework_classify.py) at its (x, y).
 """
 
 from __future__ import annotations
@@ -29,7 +41,7 @@ from ..analysis.framework_classify import (
 )
 from ..backends.endpoints import Endpoints
 from ..backends.homotopy import generic_set, track
-from ..backends.start_system import fewest_paths_groups
+from ..backends.start_system import bezout_number, fewest_paths_groups, group_degrees
 from ..errors import ParameterError
 from ..model.framework.compiled import framework_system
 from ..model.framework.folds import LINE, CurveSystem, curve_system
@@ -38,6 +50,10 @@ from ..model.framework.units import normalized_slots, units
 from ..settings import Settings, Tolerances
 from .curve_trace import Traced, Window, newton, trace
 
+SEED_ROUTES = ("auto", "witness", "sweep")
+WITNESS_MAX_PATHS = 600  # "auto": above this many paths the fold witness set is not solved
+SWEEP_POINTS = 101  # equilibria solved along each seed line (route "sweep")
+SWEEP_BISECTIONS = 4  # most halvings of a bracket (each a solve) before it is reported unrefined
 SPACING = 0.002  # consecutive points of a curve: at most this fraction of the window diagonal
 LINES = 9  # seed lines in each direction (the window's edges among them)
 HMAX = 0.05  # largest step in (X, v, mx, my), normalised units
@@ -63,12 +79,16 @@ def framework_fold_curves(
     yrange: tuple[float, float],
     settings: Settings | None = None,
     kinds: tuple[str, ...] = ("fold", "cable_switch"),
+    seeds: str = "auto",
 ) -> tuple[pd.DataFrame, dict]:
     """Fold curves, cusps and cable switches of `fw` in the window xrange x yrange of its
     parameters xname, yname: one row a point (docs/columns.md, "framework folds") and the record
-    for run.json. `kinds`: which curves to compute (fold curves bring their cusps)."""
+    for run.json. `kinds`: which curves to compute (fold curves bring their cusps); `seeds`:
+    how points on the seed lines are found ("witness", "sweep" or "auto", module docstring)."""
     settings = settings or Settings()
     _check(fw, xname, xrange, yname, yrange)
+    if seeds not in SEED_ROUTES:
+        raise ParameterError(f"seeds: {seeds!r} is not a seed route ({', '.join(SEED_ROUTES)})")
     for kind in kinds:
         if kind not in ("fold", "cable_switch"):
             raise ParameterError(f"kinds: {kind!r} is not a curve kind (fold, cable_switch)")
@@ -85,7 +105,7 @@ def framework_fold_curves(
         chosen = ([""] if "fold" in kinds else []) + (cables if "cable_switch" in kinds else [])
         for cable in chosen:
             cs = curve_system(centre, taut, xname, yname, cable)
-            curves, info = _find(fw, cs, (xname, xrange), (yname, yrange), settings)
+            curves, info = _find(fw, cs, (xname, xrange), (yname, yrange), settings, seeds)
             frame, next_id, about = _rows(fw, curves, xname, yname, next_id)
             frames.append(frame)
             record["taut_sets"].setdefault(" ".join(taut) or "none", {})[
@@ -93,7 +113,7 @@ def framework_fold_curves(
     table = pd.concat(frames, ignore_index=True) if frames else _empty(fw, xname, yname)
     record.update(
         window={xname: list(xrange), yname: list(yrange)}, spacing=SPACING, lines=LINES,
-        kinds=list(kinds),
+        kinds=list(kinds), seeds=seeds,
         seed=settings.seed, seconds=time.perf_counter() - t0,
         counts={k: int((table["kind"] == k).sum()) for k in ("fold", "cusp", "cable_switch")},
         curves_found=int(table.loc[table["curve_id"] >= 0, "curve_id"].nunique()),
@@ -129,9 +149,7 @@ def _equations(cs: CurveSystem):
     """The traced equations of z = (X, mx, my): the curve system's residual and Jacobian."""
 
     def eqs(z: np.ndarray, zref: np.ndarray):
-        F = np.array([complex(e).real for e in cs.numeric.residual(z)])
-        J = np.array([complex(e).real for e in cs.numeric.jacobian(z)]).reshape(len(F), len(z))
-        return F, J
+        return cs.trace.evaluate(z)[0].real, cs.trace.jacobian(z)[0].real
 
     return eqs
 
@@ -139,10 +157,7 @@ def _equations(cs: CurveSystem):
 def _line_seeds(cs, gs, win: Window, settings) -> tuple[list, list[dict]]:
     """Real points of the curve on LINES vertical and LINES horizontal lines of the window."""
     seeds, lines = [], []
-    (xl, yl), (xh, yh) = win.lo, win.hi
-    specs = [(xv, yl, 0.0, yh - yl) for xv in np.linspace(xl, xh, LINES)]
-    specs += [(xl, yv, xh - xl, 0.0) for yv in np.linspace(yl, yh, LINES)]
-    for x0, y0, dx, dy in specs:
+    for x0, y0, dx, dy in _line_specs(win):
         target = {LINE[0]: x0, LINE[1]: y0, LINE[2]: dx, LINE[3]: dy}
         # Straight from the witness set, no fallback: on a real line some paths go to infinity
         # (on every line tried, axis-parallel or not), which is expected, not a failure. A seed
@@ -161,44 +176,182 @@ def _line_seeds(cs, gs, win: Window, settings) -> tuple[list, list[dict]]:
     return seeds, lines
 
 
-def _find(fw: Framework, cs: CurveSystem, xaxis, yaxis, settings) -> tuple[_Curves, dict]:
-    """Witness set, seeds on lines, and every curve through a seed traced once."""
+def _find(fw: Framework, cs: CurveSystem, xaxis, yaxis, settings, seeds: str) -> tuple:
+    """Seeds on lines (by the chosen route), and every curve through a seed traced once."""
     (xname, xrange), (yname, yrange) = xaxis, yaxis
     t0 = time.perf_counter()
-    centre = _centre(cs, fw, xname, yname)
-    gs = generic_set(cs.ps, settings.seed, centre=centre, groups=_groups(cs, settings.seed))
-    t1 = time.perf_counter()
     sx, sy = cs.scales
     nz = len(cs.variables)
     win = Window(nz, nz + 1, (xrange[0] / sx, yrange[0] / sy), (xrange[1] / sx, yrange[1] / sy),
                  (sx, sy))  # fmt: skip
-    seeds, lines = _line_seeds(cs, gs, win, settings)
+    groups = _groups(cs, settings.seed)
+    paths = bezout_number(_degrees(cs, settings.seed, groups), [len(g) for g in groups])
+    route = seeds if seeds != "auto" else "witness" if paths <= WITNESS_MAX_PATHS else "sweep"
+    info: dict = {"seed_route": route, "witness_paths": paths}
+    if route == "witness":
+        centre = _centre(cs, fw, xname, yname)
+        gs = generic_set(cs.ps, settings.seed, centre=centre, groups=groups)
+        info.update(generic_set=gs.summary(), generic_seconds=time.perf_counter() - t0)
+        t1 = time.perf_counter()
+        seeds_found, lines = _line_seeds(cs, gs, win, settings)
+    else:
+        t1 = time.perf_counter()
+        seeds_found, lines = _sweep_seeds(fw, cs, win, (xname, yname), settings)
+        info.update(sweep_points=SWEEP_POINTS)
     t2 = time.perf_counter()
     eqs = _equations(cs)
     traced, skipped = [], 0
     lengths = [k for k, v in enumerate(cs.variables) if v.startswith("d_")]
-    for z in seeds:
+    for z in seeds_found:
         if (z[lengths] <= 0).any():
             continue  # a length never changes sign on a curve (L0 > 0): never physical
         if any(_on(c.points, z, win, len(cs.variables)) for c in traced):
             skipped += 1
             continue
         traced.append(trace(eqs, z, win, SPACING, HMAX))
-    info = {
-        "generic_set": gs.summary(), "generic_seconds": t1 - t0, "lines_seconds": t2 - t1,
-        "trace_seconds": time.perf_counter() - t2, "seeds": len(seeds), "seeds_on_traced": skipped,
-        "lines": lines, "ends": [list(c.ends) for c in traced],
-        "lost_paths": int(sum(ln["lost"] for ln in lines)),
-    }  # fmt: skip
+    info.update({
+        "lines_seconds": t2 - t1, "trace_seconds": time.perf_counter() - t2,
+        "seeds": len(seeds_found), "seeds_on_traced": skipped, "lines": lines,
+        "ends": [list(c.ends) for c in traced],
+        "lost_paths": int(sum(ln.get("lost", 0) for ln in lines)),
+        "unrefined_brackets": int(sum(ln.get("unrefined", 0) for ln in lines)),
+    })  # fmt: skip
     return _Curves(cs, traced, win, eqs), info
+
+
+def _line_specs(win: Window) -> list[tuple[float, float, float, float]]:
+    """(x0, y0, dx, dy) of the LINES vertical and LINES horizontal seed lines, edges included."""
+    (xl, yl), (xh, yh) = win.lo, win.hi
+    specs = [(xv, yl, 0.0, yh - yl) for xv in np.linspace(xl, xh, LINES)]
+    return specs + [(xl, yv, xh - xl, 0.0) for yv in np.linspace(yl, yh, LINES)]
+
+
+def _sweep_seeds(fw: Framework, cs: CurveSystem, win: Window, names, settings) -> tuple:
+    """Fold points on each seed line from the equilibria along it (route "sweep")."""
+    seeds, lines = [], []
+    for spec in _line_specs(win):
+        solve = _line_solver(fw, cs, spec, names, settings)
+        ts = np.linspace(0.0, 1.0, SWEEP_POINTS)
+        sols = [solve(ts[0], None)]
+        for t in ts[1:]:
+            sols.append(solve(t, sols[-1].warm))
+        real = [_real_points(h) for h in sols]
+        rec = {"line": list(spec), "points": SWEEP_POINTS, "brackets": 0, "unrefined": 0,
+               "real_in_window": 0, "lost": int(sum(h.info["lost"] for h in sols))}  # fmt: skip
+        for k in range(SWEEP_POINTS - 1):
+            change = len(real[k]) - len(real[k + 1])
+            if change == 0 or change % 2:
+                continue  # an odd change: a point through infinity, not a fold
+            rec["brackets"] += 1
+            found = _refine_bracket(cs, spec, solve, (ts[k], sols[k]), (ts[k + 1], sols[k + 1]))
+            rec["unrefined"] += not found
+            rec["real_in_window"] += len(found)
+            seeds += found
+        lines.append(rec)
+    return seeds, lines
+
+
+def _line_solver(fw: Framework, cs: CurveSystem, spec, names, settings):
+    """t -> every equilibrium of the taut set at the point t of the line (backends.target)."""
+    from ..backends.target import solve_parameters
+    from ..model.framework.compiled import variable_groups
+
+    (x0, y0, dx, dy), (sx, sy) = spec, cs.scales
+    centre = normalized_slots(fw.at_defaults())
+
+    def solve(t: float, warm):
+        fwp = fw.replace(**{names[0]: (x0 + t * dx) * sx, names[1]: (y0 + t * dy) * sy})
+        fs = framework_system(fwp, cs.taut)
+        if tuple(fs.ps.variables) != cs.variables:
+            raise AssertionError("the fold system's unknowns differ from the equilibria's")
+        return solve_parameters(fs.ps, normalized_slots(fwp), centre, settings,
+                                variable_groups(fs), warm)  # fmt: skip
+
+    return solve
+
+
+def _real_points(hs) -> np.ndarray:
+    """The real endpoints of a solve (real parts), one row each."""
+    pts = hs.endpoints.points
+    if not len(pts):
+        return np.zeros((0, pts.shape[1] if pts.ndim == 2 else 0))
+    real = (np.abs(pts.imag) / (1 + np.abs(pts.real))).max(axis=1) < 1e-6
+    return pts[real].real
+
+
+def _refine_bracket(cs: CurveSystem, spec, solve, a: tuple, b: tuple) -> list[np.ndarray]:
+    """The fold points of a bracket of the line where the real count changes (none if Newton
+    never lands in it within SWEEP_BISECTIONS halvings)."""
+    (ta, ha), (tb, hb) = a, b
+    eqs = _equations(cs)
+    for _ in range(SWEEP_BISECTIONS + 1):
+        ra, rb = _real_points(ha), _real_points(hb)
+        (more, t_more), fewer = ((ra, ta), rb) if len(ra) > len(rb) else ((rb, tb), ra)
+        width = tb - ta
+        found = []
+        for pair in _merging_pairs(more, fewer):
+            hit = _line_newton(eqs, pair.mean(axis=0), t_more, spec)
+            if hit is not None and ta - width <= hit[1] <= tb + width and 0 <= hit[1] <= 1:
+                found.append(hit[0])
+        if found:
+            return found
+        tm = 0.5 * (ta + tb)
+        hm = solve(tm, ha.warm)
+        if len(_real_points(hm)) == len(ra):
+            ta, ha = tm, hm
+        else:
+            tb, hb = tm, hm
+    return []
+
+
+def _merging_pairs(more: np.ndarray, fewer: np.ndarray) -> list[np.ndarray]:
+    """The pairs of rows of `more` that meet at the folds between two samples: those with no
+    counterpart among `fewer` (the farthest from their nearest row there), paired closest
+    first."""
+    count = (len(more) - len(fewer)) // 2
+    if len(fewer):
+        lone = np.abs(more[:, None, :] - fewer[None, :, :]).max(axis=2).min(axis=1)
+        left = list(np.argsort(-lone, kind="stable")[: 2 * count])
+    else:
+        left = list(range(len(more)))
+    out = []
+    for _ in range(count):
+        if len(left) < 2:
+            break
+        i, j = min(((i, j) for i in left for j in left if i < j),
+                   key=lambda p: np.abs(more[p[0]] - more[p[1]]).max())  # fmt: skip
+        out.append(more[[i, j]])
+        left = [k for k in left if k not in (i, j)]
+    return out
+
+
+def _line_newton(eqs, X: np.ndarray, t: float, spec) -> tuple | None:
+    """Newton on the curve system with (mx, my) held to the line: (z, its line parameter)."""
+    x0, y0, dx, dy = spec
+    start = np.concatenate([X, [x0 + t * dx, y0 + t * dy]])
+    normal = np.zeros(len(start))
+    normal[-2:] = -dy, dx
+    z = newton(eqs, start, start, lambda w: (normal @ (w - start), normal))
+    if z is None:
+        return None
+    return z, float(((z[-2] - x0) * dx + (z[-1] - y0) * dy) / (dx * dx + dy * dy))
 
 
 def _groups(cs: CurveSystem, seed: int) -> list[list[str]]:
     """The witness set's variable groups: the equilibrium system's plus tline, merged where that
     lowers the path count (the degree structure read at random complex line coefficients)."""
+    return fewest_paths_groups(_at_random_line(cs, seed), cs.groups)
+
+
+def _at_random_line(cs: CurveSystem, seed: int):
     rng = np.random.default_rng(seed)
     line = rng.normal(size=len(cs.ps.parameters)) + 1j * rng.normal(size=len(cs.ps.parameters))
-    return fewest_paths_groups(cs.ps.instantiate(line), cs.groups)
+    return cs.ps.instantiate(line)
+
+
+def _degrees(cs: CurveSystem, seed: int, groups: list[list[str]]) -> np.ndarray:
+    """The witness system's degree in each group, equation by equation."""
+    return group_degrees(_at_random_line(cs, seed), groups)
 
 
 def _on(points: np.ndarray, z: np.ndarray, win: Window, nx: int) -> bool:

@@ -9,9 +9,11 @@ units) and two map parameters (x, y) of the file, a curve is F = 0 plus one more
 - switch of cable c (taut, L0 > 0): d_c = L0_c (the cable exactly at its free length, so it
   exerts no force and the equilibrium is also one of the taut set without c).
 
-Each is generated twice from the same sympy expressions: numpy code of the curve's residual and
-Jacobian in Z = (X, mx, my) (mx = x / sx, my = y / sy: the map coordinates in the units of the
-slots they enter) for tracing; and a Bertini system with (mx, my) = (x0, y0) + tline (dx, dy) on a
+Each is generated twice from the same sympy expressions: the curve's equations as polynomials in
+Z = (X, mx, my) (mx = x / sx, my = y / sy: the map coordinates in the units of the slots they
+enter) for tracing, evaluated term-vectorised by model/polynomial.py (a two-body fold equation
+has over a thousand terms: generated scalar code took milliseconds a Jacobian); and a Bertini
+system with (mx, my) = (x0, y0) + tline (dx, dy) on a
 line, tline unknown, whose parameters are the line's coefficients: solved once at a random
 complex line (a witness set of the curve), then reached on any real line by parameter homotopy.
 The file's other parameters enter as their values (_slot_values). Cached on disk by structure,
@@ -22,7 +24,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import types
 from dataclasses import asdict, dataclass
 from functools import cache
 from pathlib import Path
@@ -32,7 +33,7 @@ from sympy.polys.matrices import DomainMatrix
 
 from ...errors import ParameterError
 from ...fs import files_hash
-from ..polynomial import ParametricSystem
+from ..polynomial import ParametricSystem, PolySystem
 from .compiled import cached_derivation, framework_system, variable_groups
 from .expressions import Expr
 from .spec import Framework
@@ -51,7 +52,8 @@ class CurveDerived:
     variables: list[str]  # X: the equilibrium system's unknowns, in its order
     system: dict  # ParametricSystem JSON: unknowns X, tline; parameters LINE
     scales: list[float]  # (sx, sy): user value = scale * map coordinate
-    source: str  # numpy: residual(Z), jacobian(Z); Z = X, mx, my
+    trace: dict  # ParametricSystem JSON without parameters: the equations in Z = X, mx, my
+    source: str = ""  # no generated code (cached_derivation compiles what there is)
 
 
 @dataclass(frozen=True, eq=False)
@@ -65,7 +67,7 @@ class CurveSystem:
     variables: tuple[str, ...]
     ps: ParametricSystem
     scales: tuple[float, float]
-    numeric: types.ModuleType
+    trace: PolySystem  # the equations in Z = (X, mx, my)
     groups: list[list[str]]
 
 
@@ -183,7 +185,7 @@ def fold_condition(fw: Framework, taut: tuple[str, ...], values: dict) -> sp.Exp
 
 def _derive(fw: Framework, taut: tuple[str, ...], xname: str, yname: str, cable: str) -> dict:
     """The curve system (fold when `cable` is empty, else that cable's switch) as plain data."""
-    from ..symbolic import numpy_function, parametric_from_sympy
+    from ..symbolic import parametric_from_sympy
     from .derive import equilibrium_equations
 
     names, _, F, _ = equilibrium_equations(fw, taut)
@@ -197,16 +199,13 @@ def _derive(fw: Framework, taut: tuple[str, ...], xname: str, yname: str, cable:
     )
     G = [sp.expand(g.xreplace(values)) for g in [*F, extra]]
     Z = [*X, mx, my]
-    jac = sp.Matrix(G).jacobian(Z)
-    args = {"Z": Z}
-    source = "from numpy import sqrt\n\n" + numpy_function("residual", args, G)
-    source += numpy_function("jacobian", args, list(jac))
     line = {mx: sp.Symbol(LINE[0]) + t * sp.Symbol(LINE[2]),
             my: sp.Symbol(LINE[1]) + t * sp.Symbol(LINE[3])}  # fmt: skip
     eqs = [sp.expand(g.xreplace(line)) for g in G]
+    labels = tuple(f"g{i + 1}" for i in range(len(eqs)))
     try:
-        ps = parametric_from_sympy((*names, t.name), tuple(f"g{i + 1}" for i in range(len(eqs))),
-                                   tuple(eqs), LINE)  # fmt: skip
+        ps = parametric_from_sympy((*names, t.name), labels, tuple(eqs), LINE)
+        trace = parametric_from_sympy(tuple(z.name for z in Z), labels, tuple(G), ())
     except sp.PolynomialError as exc:
         raise ParameterError(
             f"{xname}, {yname}: a map parameter enters a number of framework {fw.name!r} "
@@ -219,7 +218,7 @@ def _derive(fw: Framework, taut: tuple[str, ...], xname: str, yname: str, cable:
             names,
             ps.to_json(),
             list(map_scales(fw, xname, yname)),
-            source,
+            trace.to_json(),
         )  # fmt: skip
     )
 
@@ -252,14 +251,15 @@ def curve_system(
     key = curve_key(fw, taut, xname, yname, cable)
     if key in _LOADED:
         return _LOADED[key]
-    data, module = cached_derivation(
+    data, _ = cached_derivation(
         f"curve-{key}", CurveDerived, lambda: CurveDerived(**_derive(fw, taut, xname, yname, cable))
     )
     groups = [*variable_groups(framework_system(fw, taut)), ["tline"]]
     out = CurveSystem(
         key, taut, data.kind, data.cable, tuple(data.variables),
         ParametricSystem.from_json(data.system),
-        (data.scales[0], data.scales[1]), module, groups,
+        (data.scales[0], data.scales[1]), ParametricSystem.from_json(data.trace).instantiate([]),
+        groups,
     )  # fmt: skip
     _LOADED[key] = out
     return out

@@ -247,7 +247,7 @@ def test_zeeman_cables_switch_curve_against_a_scan():
         assert change == (1 if row["changes_stable_count"] else 0)
 
 
-@pytest.mark.slow  # cotm.toml's fold witness set: minutes cold (see docs/design.md)
+@pytest.mark.slow  # cotm.toml's fold seeds by sweeps: minutes (see docs/design.md)
 def test_cotm_toml_folds_lie_on_the_closed_form_curves():
     """The fold curves of examples/cotm.toml by the Bertini route, over the paper's window
     (0, 14]^2, against the built-in closed form (analysis/fold_curves.py: the parallel curve and

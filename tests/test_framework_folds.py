@@ -247,6 +247,59 @@ def test_zeeman_cables_switch_curve_against_a_scan():
         assert change == (1 if row["changes_stable_count"] else 0)
 
 
+def _cotm_springs(g1, g2):
+    """The two spring vectors (p6 - p2, p5 - p3) of the paper's mechanism at poses (gamma1,
+    gamma2) and their derivatives in gamma1 and gamma2: plain numpy from Table 1's geometry
+    (not the framework's derivation)."""
+    rod = 9.0 * np.array([np.cos(g1), np.sin(g1)])
+    rod_1 = 9.0 * np.array([-np.sin(g1), np.cos(g1)])
+    c, s = np.cos(g2), np.sin(g2)
+    top6, top6_2 = 4.25 * np.array([c, s]), 4.25 * np.array([-s, c])
+    top5 = np.array([-0.299 * c + 3.4872 * s, -0.299 * s - 3.4872 * c])
+    top5_2 = np.array([0.299 * s + 3.4872 * c, -0.299 * c + 3.4872 * s])
+    r1 = rod + top6 - np.array([3.1875, 0.0])[:, None]
+    r2 = rod + top5 - np.array([-2.5745, 4.9309])[:, None]
+    return (r1, rod_1, top6_2), (r2, rod_1, top5_2)
+
+
+def test_cotm_relaxed_folds_against_plain_geometry_and_the_closed_form():
+    """cotm.toml's relaxed folds (both springs at their free length, where the fold system is
+    singular): each point's free lengths are its spring lengths and the lengths' Jacobian in
+    the two angles is singular (plain numpy, central differences), each changes the stable
+    count, and they lie on the closed form's relaxed family (analysis/fold_curves.py) and
+    cover it in the window."""
+    from cotm_bertini.analysis.fold_curves import fold_curves
+    from cotm_bertini.continuation import framework_folds as ff
+    from cotm_bertini.model.framework.folds import RELAXED, curve_system
+
+    fw = cb.Framework.from_toml(EXAMPLES / "cotm.toml")
+    window = (1e-3, 14.0)
+    cs = curve_system(fw.replace(L01=7.0, L02=7.0), (), "L01", "L02", RELAXED)
+    curves, info = ff._find(fw, cs, ("L01", window), ("L02", window), cb.Settings(), "auto")
+    table, _, about = ff._rows(fw, curves, "L01", "L02", 0)
+    assert info["seed_route"] == "witness" and info["lost_paths"] == 0
+    assert about["artefacts"] == 0 and len(table) > 500 and table["physical"].all()
+    assert table["changes_stable_count"].all() and set(table["kind"]) == {"fold"}
+    g1 = np.radians(table["rod.angle_deg"].to_numpy())
+    g2 = np.radians(table["top.angle_deg"].to_numpy())
+    springs = _cotm_springs(g1, g2)
+    L0 = table[["L01", "L02"]].to_numpy()
+    lengths = np.stack([np.hypot(*r) for r, _, _ in springs], axis=1)
+    assert np.abs(lengths - L0).max() < 1e-9 * 14
+    # The gradients of |r|^2 / 2 in (gamma1, gamma2): parallel.
+    grads = [np.stack([(r * a).sum(axis=0), (r * b).sum(axis=0)]) for r, a, b in springs]
+    det = grads[0][0] * grads[1][1] - grads[0][1] * grads[1][0]
+    scale = np.hypot(*grads[0]) * np.hypot(*grads[1])
+    assert (np.abs(det) < 1e-6 * scale).all()
+    closed = fold_curves(cb.Params.case("case3"))
+    closed = closed[(closed["family"] == "relaxed") & closed["physical"]
+                    & closed["L01"].between(*window) & closed["L02"].between(*window)]  # fmt: skip
+    assert len(closed) > 100
+    c = closed[["L01", "L02"]].to_numpy()
+    nearest = np.sqrt(((c[:, None, :] - L0[None, :, :]) ** 2).sum(axis=2)).min(axis=1)
+    assert nearest.max() <= SPACING * np.hypot(14.0, 14.0)
+
+
 @pytest.mark.slow  # cotm.toml's fold seeds by sweeps: minutes (see docs/design.md)
 def test_cotm_toml_folds_lie_on_the_closed_form_curves():
     """The fold curves of examples/cotm.toml by the Bertini route, over the paper's window

@@ -8,9 +8,10 @@ window's edges among them) are found by one of two routes, both Bertini's:
   parameter homotopy: every fold point on the line;
 - "sweep": the equilibria of the taut set are solved at SWEEP_POINTS points along each line
   (parameter homotopy from the equilibrium system's generic set, then Newton continuation
-  checked complete, as a sweep does); where the number of real equilibria changes by an even
-  number between neighbours, the interval is bisected until Newton on the fold system, started
-  from the mean of the closest real pair, lands in it. Two folds closer together on a line than
+  checked complete, as a sweep does); where the number of real equilibria with positive
+  lengths changes by an even number between neighbours, the interval is bisected until Newton
+  on the fold system, started from the mean of each pair without a counterpart on the other
+  side, lands in it. Two folds closer together on a line than
   its sampling are not seen there. For systems whose witness set is too costly (cotm.toml's:
   1,408 paths, each slow in Bertini 2 for a 1,226-term fold equation).
 
@@ -44,7 +45,13 @@ from ..backends.homotopy import generic_set, track
 from ..backends.start_system import bezout_number, fewest_paths_groups, group_degrees
 from ..errors import ParameterError
 from ..model.framework.compiled import framework_system
-from ..model.framework.folds import LINE, CurveSystem, curve_system
+from ..model.framework.folds import (
+    LINE,
+    RELAXED,
+    CurveSystem,
+    curve_system,
+    relaxed_applies,
+)
 from ..model.framework.spec import Framework
 from ..model.framework.units import normalized_slots, units
 from ..settings import Settings, Tolerances
@@ -103,13 +110,15 @@ def framework_fold_curves(
             continue  # moves freely: no isolated equilibria, so no folds (continuum_check's job)
         cables = [c for c in taut if normalized_slots(centre)[f"L0_{c}"] != 0]
         chosen = ([""] if "fold" in kinds else []) + (cables if "cable_switch" in kinds else [])
+        if "fold" in kinds and relaxed_applies(centre, taut):
+            chosen.insert(1, RELAXED)
         for cable in chosen:
             cs = curve_system(centre, taut, xname, yname, cable)
             curves, info = _find(fw, cs, (xname, xrange), (yname, yrange), settings, seeds)
             frame, next_id, about = _rows(fw, curves, xname, yname, next_id)
             frames.append(frame)
-            record["taut_sets"].setdefault(" ".join(taut) or "none", {})[
-                cable and f"switch {cable}" or "fold"] = {**info, **about}  # fmt: skip
+            name = {"": "fold", RELAXED: "relaxed fold"}.get(cable, f"switch {cable}")
+            record["taut_sets"].setdefault(" ".join(taut) or "none", {})[name] = {**info, **about}
     table = pd.concat(frames, ignore_index=True) if frames else _empty(fw, xname, yname)
     record.update(
         window={xname: list(xrange), yname: list(yrange)}, spacing=SPACING, lines=LINES,
@@ -271,12 +280,14 @@ def _line_solver(fw: Framework, cs: CurveSystem, spec, names, settings):
 
 
 def _real_points(hs) -> np.ndarray:
-    """The real endpoints of a solve (real parts), one row each."""
+    """The real endpoints of a solve with every length positive (real parts), one row each: a
+    length never changes sign along a branch (L0 > 0), so only these meet at physical folds."""
     pts = hs.endpoints.points
     if not len(pts):
         return np.zeros((0, pts.shape[1] if pts.ndim == 2 else 0))
     real = (np.abs(pts.imag) / (1 + np.abs(pts.real))).max(axis=1) < 1e-6
-    return pts[real].real
+    lengths = [k for k, v in enumerate(hs.endpoints.variables) if v.startswith("d_")]
+    return pts[real & (pts.real[:, lengths] > 0).all(axis=1)].real
 
 
 def _refine_bracket(cs: CurveSystem, spec, solve, a: tuple, b: tuple) -> list[np.ndarray]:
@@ -386,7 +397,7 @@ def _classify(fw: Framework, cs: CurveSystem, z: np.ndarray, xname: str, yname: 
     row = {xname: x, yname: y, **{c: cols[c][0] for c in _solution_columns(fw)}}
     row["physical"] = bool(cols["physical"][0])
     index, zero = _index(fs, fwp, z[:nx])
-    if cs.kind == "fold":
+    if cs.kind in ("fold", "relaxed"):
         if not zero:
             return {**row, "changes_stable_count": None}
         row["changes_stable_count"] = index == 0  # a minimum meets an index-1 saddle
@@ -435,7 +446,7 @@ def _rows(fw: Framework, curves: _Curves, xname: str, yname: str, next_id: int) 
     """The table of one curve system's curves (physical points only, a curve split where it
     stops being physical), the next free curve_id, and counts for the record."""
     cs, win = curves.cs, curves.window
-    kind = "fold" if cs.kind == "fold" else "cable_switch"
+    kind = "cable_switch" if cs.kind == "switch" else "fold"  # a relaxed fold is a fold
     rows, artefacts, cusps = [], 0, 0
     for curve in curves.traced:
         classified = [_classify(fw, cs, z, xname, yname) for z in curve.points]

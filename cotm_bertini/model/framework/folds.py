@@ -6,6 +6,12 @@ units) and two map parameters (x, y) of the file, a curve is F = 0 plus one more
 - fold: the bordered Hessian of the Lagrangian (the reduced Hessian bordered by the constraints'
   Jacobian, in local coordinates) is singular, its determinant cleared of the springs' 1/d
   (fold_condition): no null vector among the unknowns, so the system stays as small as F;
+- relaxed fold (no loads, no bars or closing pins, as many springs and taut cables as degrees of
+  freedom, every one with L0 > 0): every force density w = 0 (each link at its free length, a
+  configuration of zero energy) and the lengths' Jacobian in local coordinates singular
+  (relaxed_condition): where two zero-energy minima meet with the saddle between them. There the
+  fold system above is singular (its Jacobian loses rank: the moment equations vanish with w),
+  so neither Newton nor tracing works on it, and these folds get their own system;
 - switch of cable c (taut, L0 > 0): d_c = L0_c (the cable exactly at its free length, so it
   exerts no force and the equilibrium is also one of the taut set without c).
 
@@ -41,13 +47,14 @@ from .structure import source_hash, structure_key
 from .units import normalized_slots, scale_of, slot_kind, units
 
 LINE = ("line_x0", "line_y0", "line_dx", "line_dy")
+RELAXED = "(relaxed)"  # curve_system's `cable` for the relaxed folds (no cable name has brackets)
 
 
 @dataclass(frozen=True)
 class CurveDerived:
     """A curve system as plain data (JSON-able)."""
 
-    kind: str  # "fold" or "switch"
+    kind: str  # "fold", "relaxed" or "switch"
     cable: str  # the cable at its free length (switch), else ""
     variables: list[str]  # X: the equilibrium system's unknowns, in its order
     system: dict  # ParametricSystem JSON: unknowns X, tline; parameters LINE
@@ -183,8 +190,48 @@ def fold_condition(fw: Framework, taut: tuple[str, ...], values: dict) -> sp.Exp
     return sp.expand(out)
 
 
+def relaxed_applies(fw: Framework, taut: tuple[str, ...]) -> bool:
+    """Whether a taut set can have relaxed folds (module docstring)."""
+    from .derive import _active, local_frame
+
+    local, _, _, cons, _ = local_frame(fw)
+    links = _active(fw, taut)
+    zfl = set(fw.zero_free_length())
+    return (not fw.loads and not cons and len(links) == len(local)
+            and not any(x.name in zfl for x in links))  # fmt: skip
+
+
+def relaxed_condition(fw: Framework, taut: tuple[str, ...]) -> sp.Expr:
+    """det [d(|r_s|^2) / d local_j]: the links' squared lengths as functions of the local
+    coordinates have a singular Jacobian (square where relaxed_applies)."""
+    from .derive import _active, local_frame
+
+    local, at, pos, _, _ = local_frame(fw)
+    rows = []
+    for x in _active(fw, taut):
+        r = pos.of(x.a) - pos.of(x.b)
+        rows.append([2 * r.subs(at).dot(sp.diff(r, a).subs(at)) for a in local])
+    return sp.expand(sp.Matrix(rows).det())
+
+
+def _curve_equations(fw: Framework, taut: tuple[str, ...], cable: str, F: list, values: dict):
+    """The curve's equations before the slots' values: F plus one (fold, switch), or for the
+    relaxed folds F with every w = 0 (the moments vanish and are dropped), w = 0 and the
+    condition."""
+    if cable == RELAXED:
+        from .derive import _active
+
+        w0 = {sp.Symbol(f"w_{x.name}"): 0 for x in _active(fw, taut)}
+        kept = [f.xreplace(w0) for f in F]
+        return [f for f in kept if f != 0] + list(w0) + [relaxed_condition(fw, taut)]
+    if cable:
+        return [*F, sp.Symbol(f"d_{cable}") - sp.Symbol(f"L0_{cable}")]
+    return [*F, fold_condition(fw, taut, values)]
+
+
 def _derive(fw: Framework, taut: tuple[str, ...], xname: str, yname: str, cable: str) -> dict:
-    """The curve system (fold when `cable` is empty, else that cable's switch) as plain data."""
+    """The curve system (fold when `cable` is empty, relaxed folds for RELAXED, else that cable's
+    switch) as plain data."""
     from ..symbolic import parametric_from_sympy
     from .derive import equilibrium_equations
 
@@ -192,12 +239,9 @@ def _derive(fw: Framework, taut: tuple[str, ...], xname: str, yname: str, cable:
     X = [sp.Symbol(n) for n in names]
     mx, my, t = sp.symbols("map_x map_y tline")
     values = _slot_values(fw, xname, yname, mx, my)
-    extra = (
-        sp.Symbol(f"d_{cable}") - sp.Symbol(f"L0_{cable}")
-        if cable
-        else fold_condition(fw, taut, values)
-    )
-    G = [sp.expand(g.xreplace(values)) for g in [*F, extra]]
+    G = [sp.expand(g.xreplace(values)) for g in _curve_equations(fw, taut, cable, F, values)]
+    if len(G) != len(X) + 1:
+        raise AssertionError(f"{len(G)} curve equations in {len(X)} unknowns and (x, y)")
     Z = [*X, mx, my]
     line = {mx: sp.Symbol(LINE[0]) + t * sp.Symbol(LINE[2]),
             my: sp.Symbol(LINE[1]) + t * sp.Symbol(LINE[3])}  # fmt: skip
@@ -213,8 +257,8 @@ def _derive(fw: Framework, taut: tuple[str, ...], xname: str, yname: str, cable:
         ) from None
     return asdict(
         CurveDerived(
-            "switch" if cable else "fold",
-            cable,
+            "relaxed" if cable == RELAXED else "switch" if cable else "fold",
+            "" if cable == RELAXED else cable,
             names,
             ps.to_json(),
             list(map_scales(fw, xname, yname)),
@@ -245,8 +289,8 @@ _LOADED: dict[str, CurveSystem] = {}
 def curve_system(
     fw: Framework, taut: tuple[str, ...], xname: str, yname: str, cable: str = ""
 ) -> CurveSystem:
-    """The fold system (cable "") or a cable's switch system of a taut set, from memory, the
-    disk cache, or derived with sympy."""
+    """The fold system (cable ""), the relaxed folds' (RELAXED) or a cable's switch system of a
+    taut set, from memory, the disk cache, or derived with sympy."""
     taut = tuple(sorted(taut))
     key = curve_key(fw, taut, xname, yname, cable)
     if key in _LOADED:

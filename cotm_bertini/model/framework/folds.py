@@ -6,7 +6,7 @@ units) and two map parameters (x, y) of the file, a curve is F = 0 plus one more
 - fold: the bordered Hessian of the Lagrangian (the reduced Hessian bordered by the constraints'
   Jacobian, in local coordinates) is singular, its determinant cleared of the springs' 1/d
   (fold_condition): no null vector among the unknowns, so the system stays as small as F;
-- relaxed fold (no loads, no bars or closing pins, as many springs and taut cables as degrees of
+- relaxed fold (no loads, no bars or closing pins, no taut cable, as many springs as degrees of
   freedom, every one with L0 > 0): every force density w = 0 (each link at its free length, a
   configuration of zero energy) and the lengths' Jacobian in local coordinates singular
   (relaxed_condition): where two zero-energy minima meet with the saddle between them. There the
@@ -197,8 +197,10 @@ def relaxed_applies(fw: Framework, taut: tuple[str, ...]) -> bool:
     local, _, _, cons, _ = local_frame(fw)
     links = _active(fw, taut)
     zfl = set(fw.zero_free_length())
+    # Cables only where every link is a spring: at zero force a cable is as slack as it is
+    # taut, and the zero-energy states of a taut set with cables are not isolated minima.
     return (not fw.loads and not cons and len(links) == len(local)
-            and not any(x.name in zfl for x in links))  # fmt: skip
+            and all(x.kind == "spring" and x.name not in zfl for x in links))  # fmt: skip
 
 
 def relaxed_condition(fw: Framework, taut: tuple[str, ...]) -> sp.Expr:

@@ -11,9 +11,12 @@ window's edges among them) are found by one of two routes, both Bertini's:
   checked complete, as a sweep does); where the number of real equilibria with positive
   lengths changes by an even number between neighbours, the interval is bisected until Newton
   on the fold system, started from the mean of each pair without a counterpart on the other
-  side, lands in it. Two folds closer together on a line than
-  its sampling are not seen there. For systems whose witness set is too costly (cotm.toml's:
-  1,408 paths, each slow in Bertini 2 for a 1,226-term fold equation).
+  side, lands in it. Two folds closer together on a line than its sampling are not seen there.
+  For systems whose witness set is too costly (cotm.toml's: 1,408 paths, each slow in Bertini 2
+  for a 1,226-term fold equation). A relaxed fold (model/framework/folds.py), where the fold
+  system is singular, is such a bracket left unrefined: the relaxed folds' own system is always
+  solved by its witness set (small: 96 paths on cotm.toml), since its sweep could not tell
+  relaxed folds from the others.
 
 "auto" takes the witness route when the witness set's multihomogeneous path count is at most
 WITNESS_MAX_PATHS, else the sweep. Each real fold point found seeds a pseudo-arclength trace of
@@ -91,7 +94,8 @@ def framework_fold_curves(
     """Fold curves, cusps and cable switches of `fw` in the window xrange x yrange of its
     parameters xname, yname: one row a point (docs/columns.md, "framework folds") and the record
     for run.json. `kinds`: which curves to compute (fold curves bring their cusps); `seeds`:
-    how points on the seed lines are found ("witness", "sweep" or "auto", module docstring)."""
+    how points on the seed lines are found ("witness", "sweep" or "auto", module docstring;
+    relaxed folds always by their witness set, which the record says)."""
     settings = settings or Settings()
     _check(fw, xname, xrange, yname, yrange)
     if seeds not in SEED_ROUTES:
@@ -196,6 +200,8 @@ def _find(fw: Framework, cs: CurveSystem, xaxis, yaxis, settings, seeds: str) ->
     groups = _groups(cs, settings.seed)
     paths = bezout_number(_degrees(cs, settings.seed, groups), [len(g) for g in groups])
     route = seeds if seeds != "auto" else "witness" if paths <= WITNESS_MAX_PATHS else "sweep"
+    if cs.kind == "relaxed":
+        route = "witness"  # module docstring: a sweep cannot tell relaxed folds from others
     info: dict = {"seed_route": route, "witness_paths": paths}
     if route == "witness":
         centre = _centre(cs, fw, xname, yname)

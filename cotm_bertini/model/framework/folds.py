@@ -197,8 +197,8 @@ def relaxed_applies(fw: Framework, taut: tuple[str, ...]) -> bool:
     local, _, _, cons, _ = local_frame(fw)
     links = _active(fw, taut)
     zfl = set(fw.zero_free_length())
-    # Cables only where every link is a spring: at zero force a cable is as slack as it is
-    # taut, and the zero-energy states of a taut set with cables are not isolated minima.
+    # No taut cable: at zero force a cable is as slack as it is taut, so the zero-energy states
+    # of a taut set with cables are not isolated minima.
     return (not fw.loads and not cons and len(links) == len(local)
             and all(x.kind == "spring" and x.name not in zfl for x in links))  # fmt: skip
 

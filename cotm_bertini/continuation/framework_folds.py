@@ -177,9 +177,8 @@ def _line_seeds(cs, gs, win: Window, settings) -> tuple[list, list[dict]]:
         # is a point of order one, so a path that diverges in double precision is not retracked.
         ends, rep = track(cs.ps, gs, target, settings, retrack_diverged=False)
         pts = ends.points
-        real = (np.abs(pts.imag) / (1 + np.abs(pts.real))).max(axis=1) < 1e-6 if len(pts) else []
         found = 0
-        for p in pts[np.asarray(real, dtype=bool)].real if len(pts) else []:
+        for p in pts[_is_real(pts)].real if len(pts) else []:
             t = p[-1]
             if -1e-9 <= t <= 1 + 1e-9:
                 seeds.append(np.concatenate([p[:-1], [x0 + t * dx, y0 + t * dy]]))
@@ -291,9 +290,13 @@ def _real_points(hs) -> np.ndarray:
     pts = hs.endpoints.points
     if not len(pts):
         return np.zeros((0, pts.shape[1] if pts.ndim == 2 else 0))
-    real = (np.abs(pts.imag) / (1 + np.abs(pts.real))).max(axis=1) < 1e-6
     lengths = [k for k, v in enumerate(hs.endpoints.variables) if v.startswith("d_")]
-    return pts[real & (pts.real[:, lengths] > 0).all(axis=1)].real
+    return pts[_is_real(pts) & (pts.real[:, lengths] > 0).all(axis=1)].real
+
+
+def _is_real(pts: np.ndarray) -> np.ndarray:
+    """Which rows are real: every imaginary part below 1e-6 relative to the real part."""
+    return (np.abs(pts.imag) / (1 + np.abs(pts.real))).max(axis=1) < 1e-6
 
 
 def _refine_bracket(cs: CurveSystem, spec, solve, a: tuple, b: tuple) -> list[np.ndarray]:

@@ -188,19 +188,21 @@ def test_bad_axes_are_refused():
         framework_fold_curves(fw, "x", (0, 1), "y", (0, 1), seeds="lines")
 
 
-@pytest.mark.slow  # 18 lines of 101 solves each: about a minute
 def test_zeeman_sweep_seeds_find_the_same_diamond():
-    """The seed route from equilibria sampled along the lines (no fold witness set): the same
-    single closed curve with four cusps, each point a double root of the independent V, and
-    its crossings of x = 0.1 where a dense scan puts them."""
+    """The seed route from the equilibria along the lines (no fold witness set: branches traced
+    from the grid's crossings, folds where they turn back): the same single closed curve with
+    four cusps, each point a double root of the independent V, and its crossings of x = 0.1
+    where a dense scan puts them."""
     fw = cb.Framework.from_toml(EXAMPLES / "zeeman.toml")
     table, record = framework_fold_curves(
         fw, "x", ZEEMAN_WINDOW[0], "y", ZEEMAN_WINDOW[1], kinds=("fold",), seeds="sweep"
     )
     info = record["taut_sets"]["none"]["fold"]
     assert info["seed_route"] == "sweep" and "generic_set" not in info
+    assert info["sweep_points"] == 9 and len(info["lines"]) == 18
+    assert sum(ln["real_in_window"] for ln in info["lines"]) >= 4  # the diamond crosses lines
     assert record["curves_found"] == 1 and record["counts"]["cusp"] == 4
-    assert info["ends"] == [["closed", "closed"]] and info["unrefined_brackets"] == 0
+    assert info["ends"] == [["closed", "closed"]] and info["unrefined_turns"] == 0
     folds = table[table["kind"] == "fold"].sort_values("arc")
     theta = np.radians(folds["wheel.angle_deg"].to_numpy())
     u = (folds["x"].to_numpy(), folds["y"].to_numpy())
@@ -300,7 +302,6 @@ def test_cotm_relaxed_folds_against_plain_geometry_and_the_closed_form():
     assert nearest.max() <= SPACING * np.hypot(14.0, 14.0)
 
 
-@pytest.mark.slow  # cotm.toml's fold seeds by sweeps: minutes (see docs/design.md)
 def test_cotm_toml_folds_lie_on_the_closed_form_curves():
     """The fold curves of examples/cotm.toml by the Bertini route, over the paper's window
     (0, 14]^2, against the built-in closed form (analysis/fold_curves.py: the parallel curve and
@@ -315,7 +316,9 @@ def test_cotm_toml_folds_lie_on_the_closed_form_curves():
     fw = cb.Framework.from_toml(EXAMPLES / "cotm.toml")
     window = (1e-9, 14.0)
     table, record = framework_fold_curves(fw, "L01", window, "L02", window, kinds=("fold",))
-    assert all(r["lost_paths"] == 0 for ts in record["taut_sets"].values() for r in ts.values())
+    for info in (r for ts in record["taut_sets"].values() for r in ts.values()):
+        assert info["lost_paths"] == 0 and info.get("unrefined_turns", 0) == 0
+    assert record["taut_sets"]["none"]["fold"]["seed_route"] == "sweep"  # 1,408 witness paths
     folds = table[table["physical"].astype(bool) & (table["kind"] == "fold")]
     assert len(folds) > 500
     g1 = np.radians(folds["rod.angle_deg"].to_numpy())

@@ -18,9 +18,12 @@ import numpy as np
 # (z, zref) -> (F (N-1,), dF/dz (N-1, N)); zref: the last accepted point (a normalisation may
 # depend on it).
 Equations = Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]
+Keep = Callable[[np.ndarray], bool] | None
 
 NEWTON_STEPS = 8
 NEWTON_TOL = 1e-11
+NEWTON_ACCEPT = 1e-7  # ... or below this and no longer halving (newton)
+RESIDUAL = 1e-8  # |F_i| at a converged point, relative to row i's scale (newton)
 MIN_STEP = 1e-9
 MAX_POINTS = 20000  # per direction
 
@@ -62,26 +65,39 @@ class Traced:
 
     points: np.ndarray  # (m, N)
     closed: bool
-    ends: tuple[str, str]  # "edge", "closed", "stalled" or "max_points"
+    ends: tuple[str, str]  # "edge", "closed", "looped", "left", "stalled" or "max_points"
 
 
 def newton(eqs: Equations, z: np.ndarray, zref: np.ndarray, extra=None) -> np.ndarray | None:
-    """Newton on F = 0 plus one more equation `extra(z) -> (value, gradient)`; None if it fails."""
+    """Newton on F = 0 plus one more equation `extra(z) -> (value, gradient)`; None if it fails.
+
+    Scale-invariant: each step solves the system with its columns scaled by 1 + |z_j| and its
+    rows then by their largest entry, and converges when every component's step, relative to
+    1 + |z_j|, is below NEWTON_TOL, or below NEWTON_ACCEPT and no longer halving (rounding);
+    the residual is judged row by row against the same row scale. Near a zero-length end a
+    force density grows like 1 / d while the angles stay of order one: unscaled, the Jacobian's
+    condition grew past 1e10 there (6.5e4 scaled) and the steps stopped short.
+    """
+    before = np.inf
     for _ in range(NEWTON_STEPS):
         F, J = eqs(z, zref)
         g, dg = extra(z)
-        A = np.vstack([J, dg])
-        b = np.append(F, g)
+        cols = 1.0 + np.abs(z)
+        A = np.vstack([J, dg]) * cols
+        rows = np.abs(A).max(axis=1)
+        rows[rows == 0] = 1.0
         try:
-            dz = np.linalg.solve(A, b)
+            dz = np.linalg.solve(A / rows[:, None], np.append(F, g) / rows) * cols
         except np.linalg.LinAlgError:
             return None
         if not np.isfinite(dz).all():
             return None
         z = z - dz
-        if np.abs(dz).max() < NEWTON_TOL * (1.0 + np.abs(z).max()):
+        size = (np.abs(dz) / (1.0 + np.abs(z))).max()
+        if size < NEWTON_TOL or size < NEWTON_ACCEPT and size > before / 2:
             F, _ = eqs(z, zref)
-            return z if np.abs(F).max() < 1e-8 * (1.0 + np.abs(z).max()) else None
+            return z if (np.abs(F) <= RESIDUAL * rows[: len(F)]).all() else None
+        before = size
     return None
 
 
@@ -92,10 +108,11 @@ def tangent(eqs: Equations, z: np.ndarray, zref: np.ndarray) -> np.ndarray:
 
 
 def _passes(a: np.ndarray, b: np.ndarray, z0: np.ndarray, h: float) -> bool:
-    """Whether the step from a to b passes z0 (the start: the curve has closed)."""
+    """Whether the step from a to b passes z0 (or any row of z0, (m, N))."""
     ab = b - a
-    s = float(np.clip((z0 - a) @ ab / max(ab @ ab, 1e-300), 0.0, 1.0))
-    return bool(np.linalg.norm(a + s * ab - z0) < 0.1 * h)
+    s = np.clip((z0 - a) @ ab / max(ab @ ab, 1e-300), 0.0, 1.0)
+    near = np.linalg.norm(a + s[..., None] * ab - z0, axis=-1) < 0.1 * h
+    return bool(np.any(near))
 
 
 def _step_size(t: np.ndarray, win: Window, spacing: float, hmax: float) -> float:
@@ -119,13 +136,16 @@ def _clip(eqs: Equations, a: np.ndarray, b: np.ndarray, win: Window) -> np.ndarr
 
 
 def _one_way(eqs: Equations, z0: np.ndarray, t0: np.ndarray, win: Window, spacing: float,
-             hmax: float) -> tuple[list[np.ndarray], str]:  # fmt: skip
-    """Points from z0 (excluded) along +t0 until the edge, back at z0, or stuck."""
+             hmax: float, keep: Keep, relative: bool) -> tuple[list[np.ndarray], str]:  # fmt: skip
+    """Points from z0 (excluded) along +t0 until the edge, back at z0, back on itself elsewhere
+    ("looped": it entered a loop through a junction, which it would go round for ever), out of
+    `keep`, or stuck."""
     out, z, t = [], z0, t0
     h = _step_size(t, win, spacing, hmax)
     travelled = 0.0
     while len(out) < MAX_POINTS:
-        h = min(h * 1.5, _step_size(t, win, spacing, hmax))
+        grow = 1.0 + np.abs(z).max() if relative else 1.0
+        h = min(h * 1.5, _step_size(t, win, spacing, hmax * grow))
         while True:
             pred = z + h * t
             new = newton(eqs, pred, z, lambda w, p=pred, t=t: (t @ (w - p), t))
@@ -141,23 +161,64 @@ def _one_way(eqs: Equations, z0: np.ndarray, t0: np.ndarray, win: Window, spacin
         if not win.inside(new):
             edge = _clip(eqs, z, new, win)
             return out + ([edge] if edge is not None else []), "edge"
+        if keep is not None and not keep(new):
+            return out, "left"
         travelled += np.linalg.norm(new - z)
         if travelled > 3 * h and _passes(z, new, z0, h):
             return out, "closed"
+        if len(out) > 3 and _passes(z, new, np.array(out[:-3]), h):
+            return out, "looped"
         out.append(new)
         z, t = new, t_new
     return out, "max_points"
 
 
 def trace(eqs: Equations, z0: np.ndarray, win: Window, spacing: float = 0.002,
-          hmax: float = 0.05) -> Traced:  # fmt: skip
+          hmax: float = 0.05, keep: Keep = None, relative: bool = False) -> Traced:  # fmt: skip
     """The curve through z0 (a point on it) both ways: `spacing` bounds consecutive points'
-    distance in the window's plane as a fraction of its diagonal, `hmax` in z."""
+    distance in the window's plane as a fraction of its diagonal, `hmax` in z (times
+    1 + max |z| if `relative`: a curve running off to infinity leaves in few steps); `keep`: the
+    part of z-space to stay in (an end that leaves it stops there, "left")."""
     t0 = tangent(eqs, z0, z0)
-    fwd, end_f = _one_way(eqs, z0, t0, win, spacing, hmax)
+    fwd, end_f = _one_way(eqs, z0, t0, win, spacing, hmax, keep, relative)
     if end_f == "closed":
         pts = [z0, *fwd, z0]
         return Traced(np.array(pts), True, ("closed", "closed"))
-    back, end_b = _one_way(eqs, z0, -t0, win, spacing, hmax)
+    back, end_b = _one_way(eqs, z0, -t0, win, spacing, hmax, keep, relative)
     pts = [*back[::-1], z0, *fwd]
     return Traced(np.array(pts), False, (end_b, end_f))
+
+
+def turning_point(eqs: Equations, za: np.ndarray, zb: np.ndarray, direction: np.ndarray,
+                  win: Window) -> np.ndarray | None:  # fmt: skip
+    """The point of the curve between za and zb (near each other on it) where its image in the
+    window's plane turns back along `direction` (a unit vector of the plane, user units): by
+    bisection on the sign of the image's velocity along it. None if that sign does not change
+    or Newton fails."""
+    t_a = zb - za
+    t_a /= np.linalg.norm(t_a)
+
+    def at(h: float):
+        pred = za + h * t_a
+        z = newton(eqs, pred, za, lambda w: (t_a @ (w - pred), t_a))
+        if z is None:
+            return None, 0.0
+        t = tangent(eqs, z, za)
+        t = t if t @ t_a > 0 else -t
+        return z, t[win.ix] * win.scale[0] * direction[0] + t[win.iy] * win.scale[1] * direction[1]
+
+    lo, hi = 0.0, float(np.linalg.norm(zb - za))
+    z_lo, f_lo = at(lo)
+    z_hi, f_hi = at(hi)
+    if z_lo is None or z_hi is None or f_lo * f_hi > 0:
+        return None
+    for _ in range(50):
+        mid = (lo + hi) / 2
+        z, f = at(mid)
+        if z is None:
+            return None
+        if f * f_lo > 0:
+            lo, f_lo = mid, f
+        else:
+            hi = mid
+    return at((lo + hi) / 2)[0]

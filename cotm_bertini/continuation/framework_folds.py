@@ -6,17 +6,14 @@ window's edges among them) are found by one of two routes, both Bertini's:
 - "witness": the fold system (model/framework/folds.py) is solved once at a random complex line
   of the (x, y) plane (a witness set of the fold curve) and brought to each real line by
   parameter homotopy: every fold point on the line;
-- "sweep": the equilibria of the taut set are solved at SWEEP_POINTS points along each line
-  (parameter homotopy from the equilibrium system's generic set, then Newton continuation
-  checked complete, as a sweep does); where the number of real equilibria with positive
-  lengths changes by an even number between neighbours, the interval is bisected until Newton
-  on the fold system, started from the mean of each pair without a counterpart on the other
-  side, lands in it. Two folds closer together on a line than its sampling are not seen there.
-  For systems whose witness set is too costly (cotm.toml's: 1,408 paths, each slow in Bertini 2
-  for a 1,226-term fold equation). A relaxed fold (model/framework/folds.py), where the fold
-  system is singular, is such a bracket left unrefined: the relaxed folds' own system is always
-  solved by its witness set (small: 96 paths on cotm.toml), since its sweep could not tell
-  relaxed folds from the others.
+- "sweep": the equilibria of the taut set are solved at the crossings of the seed lines
+  (parameter homotopy from the equilibrium system's generic set), and every real branch through
+  a crossing is traced along each line; its turning points are the folds on the line
+  (continuation/fold_sweep.py, which says what it cannot see). For systems whose witness set is
+  too costly (cotm.toml's: 1,408 paths, each slow in Bertini 2 for a 1,226-term fold equation).
+  A relaxed fold (model/framework/folds.py), where the fold system is singular, is a turning
+  point Newton cannot refine: the relaxed folds' own system is always solved by its witness set
+  (small: 96 paths on cotm.toml), since a sweep could not tell relaxed folds from the others.
 
 "auto" takes the witness route when the witness set's multihomogeneous path count is at most
 WITNESS_MAX_PATHS, else the sweep. Each real fold point found seeds a pseudo-arclength trace of
@@ -58,15 +55,14 @@ from ..model.framework.folds import (
 from ..model.framework.spec import Framework
 from ..model.framework.units import normalized_slots, units
 from ..settings import Settings, Tolerances
-from .curve_trace import Traced, Window, newton, trace
+from .curve_trace import Traced, Window, trace, turning_point
+from .fold_sweep import is_real, long_enough, sweep_seeds
 
 SEED_ROUTES = ("auto", "witness", "sweep")
 WITNESS_MAX_PATHS = 600  # "auto": above this many paths the fold witness set is not solved
-SWEEP_POINTS = 101  # equilibria solved along each seed line (route "sweep")
-SWEEP_BISECTIONS = 4  # most halvings of a bracket (each a solve) before it is reported unrefined
 SPACING = 0.002  # consecutive points of a curve: at most this fraction of the window diagonal
 LINES = 9  # seed lines in each direction (the window's edges among them)
-HMAX = 0.05  # largest step in (X, v, mx, my), normalised units
+HMAX = 0.05  # largest step in (X, mx, my), normalised units, relative to 1 + max |z|
 TURN_COS = -0.5  # image segments turning by more than 120 deg: a cusp between them
 CUSP_TOL = 1e-6  # |w . F_XX[v, v]| / |F_XX[v, v]| below this confirms a cusp
 
@@ -178,7 +174,7 @@ def _line_seeds(cs, gs, win: Window, settings) -> tuple[list, list[dict]]:
         ends, rep = track(cs.ps, gs, target, settings, retrack_diverged=False)
         pts = ends.points
         found = 0
-        for p in pts[_is_real(pts)].real if len(pts) else []:
+        for p in pts[is_real(pts)].real if len(pts) else []:
             t = p[-1]
             if -1e-9 <= t <= 1 + 1e-9:
                 seeds.append(np.concatenate([p[:-1], [x0 + t * dx, y0 + t * dy]]))
@@ -210,8 +206,9 @@ def _find(fw: Framework, cs: CurveSystem, xaxis, yaxis, settings, seeds: str) ->
         seeds_found, lines = _line_seeds(cs, gs, win, settings)
     else:
         t1 = time.perf_counter()
-        seeds_found, lines = _sweep_seeds(fw, cs, win, (xname, yname), settings)
-        info.update(sweep_points=SWEEP_POINTS)
+        specs = _line_specs(win)
+        seeds_found, lines = sweep_seeds(fw, cs, _equations(cs), specs, (xname, yname), settings)
+        info.update(sweep_points=lines[0]["points"])
     t2 = time.perf_counter()
     eqs = _equations(cs)
     traced, skipped = [], 0
@@ -222,13 +219,13 @@ def _find(fw: Framework, cs: CurveSystem, xaxis, yaxis, settings, seeds: str) ->
         if any(_on(c.points, z, win, len(cs.variables)) for c in traced):
             skipped += 1
             continue
-        traced.append(trace(eqs, z, win, SPACING, HMAX))
+        traced.append(trace(eqs, z, win, SPACING, HMAX, long_enough(cs), relative=True))
     info.update({
         "lines_seconds": t2 - t1, "trace_seconds": time.perf_counter() - t2,
         "seeds": len(seeds_found), "seeds_on_traced": skipped, "lines": lines,
         "ends": [list(c.ends) for c in traced],
         "lost_paths": int(sum(ln.get("lost", 0) for ln in lines)),
-        "unrefined_brackets": int(sum(ln.get("unrefined", 0) for ln in lines)),
+        "unrefined_turns": int(sum(ln.get("unrefined", 0) for ln in lines)),
     })  # fmt: skip
     return _Curves(cs, traced, win, eqs), info
 
@@ -238,123 +235,6 @@ def _line_specs(win: Window) -> list[tuple[float, float, float, float]]:
     (xl, yl), (xh, yh) = win.lo, win.hi
     specs = [(xv, yl, 0.0, yh - yl) for xv in np.linspace(xl, xh, LINES)]
     return specs + [(xl, yv, xh - xl, 0.0) for yv in np.linspace(yl, yh, LINES)]
-
-
-def _sweep_seeds(fw: Framework, cs: CurveSystem, win: Window, names, settings) -> tuple:
-    """Fold points on each seed line from the equilibria along it (route "sweep")."""
-    seeds, lines = [], []
-    for spec in _line_specs(win):
-        solve = _line_solver(fw, cs, spec, names, settings)
-        ts = np.linspace(0.0, 1.0, SWEEP_POINTS)
-        sols = [solve(ts[0], None)]
-        for t in ts[1:]:
-            sols.append(solve(t, sols[-1].warm))
-        real = [_real_points(h) for h in sols]
-        rec = {"line": list(spec), "points": SWEEP_POINTS, "brackets": 0, "unrefined": 0,
-               "real_in_window": 0, "lost": int(sum(h.info["lost"] for h in sols))}  # fmt: skip
-        for k in range(SWEEP_POINTS - 1):
-            change = len(real[k]) - len(real[k + 1])
-            if change == 0 or change % 2:
-                continue  # an odd change: a point through infinity, not a fold
-            rec["brackets"] += 1
-            found = _refine_bracket(cs, spec, solve, (ts[k], sols[k]), (ts[k + 1], sols[k + 1]))
-            rec["unrefined"] += not found
-            rec["real_in_window"] += len(found)
-            seeds += found
-        lines.append(rec)
-    return seeds, lines
-
-
-def _line_solver(fw: Framework, cs: CurveSystem, spec, names, settings):
-    """t -> every equilibrium of the taut set at the point t of the line (backends.target)."""
-    from ..backends.target import solve_parameters
-    from ..model.framework.compiled import variable_groups
-
-    (x0, y0, dx, dy), (sx, sy) = spec, cs.scales
-    centre = normalized_slots(fw.at_defaults())
-
-    def solve(t: float, warm):
-        fwp = fw.replace(**{names[0]: (x0 + t * dx) * sx, names[1]: (y0 + t * dy) * sy})
-        fs = framework_system(fwp, cs.taut)
-        if tuple(fs.ps.variables) != cs.variables:
-            raise AssertionError("the fold system's unknowns differ from the equilibria's")
-        return solve_parameters(fs.ps, normalized_slots(fwp), centre, settings,
-                                variable_groups(fs), warm)  # fmt: skip
-
-    return solve
-
-
-def _real_points(hs) -> np.ndarray:
-    """The real endpoints of a solve with every length positive (real parts), one row each: a
-    length never changes sign along a branch (L0 > 0), so only these meet at physical folds."""
-    pts = hs.endpoints.points
-    if not len(pts):
-        return np.zeros((0, pts.shape[1] if pts.ndim == 2 else 0))
-    lengths = [k for k, v in enumerate(hs.endpoints.variables) if v.startswith("d_")]
-    return pts[_is_real(pts) & (pts.real[:, lengths] > 0).all(axis=1)].real
-
-
-def _is_real(pts: np.ndarray) -> np.ndarray:
-    """Which rows are real: every imaginary part below 1e-6 relative to the real part."""
-    return (np.abs(pts.imag) / (1 + np.abs(pts.real))).max(axis=1) < 1e-6
-
-
-def _refine_bracket(cs: CurveSystem, spec, solve, a: tuple, b: tuple) -> list[np.ndarray]:
-    """The fold points of a bracket of the line where the real count changes (none if Newton
-    never lands in it within SWEEP_BISECTIONS halvings)."""
-    (ta, ha), (tb, hb) = a, b
-    eqs = _equations(cs)
-    for _ in range(SWEEP_BISECTIONS + 1):
-        ra, rb = _real_points(ha), _real_points(hb)
-        (more, t_more), fewer = ((ra, ta), rb) if len(ra) > len(rb) else ((rb, tb), ra)
-        width = tb - ta
-        found = []
-        for pair in _merging_pairs(more, fewer):
-            hit = _line_newton(eqs, pair.mean(axis=0), t_more, spec)
-            if hit is not None and ta - width <= hit[1] <= tb + width and 0 <= hit[1] <= 1:
-                found.append(hit[0])
-        if found:
-            return found
-        tm = 0.5 * (ta + tb)
-        hm = solve(tm, ha.warm)
-        if len(_real_points(hm)) == len(ra):
-            ta, ha = tm, hm
-        else:
-            tb, hb = tm, hm
-    return []
-
-
-def _merging_pairs(more: np.ndarray, fewer: np.ndarray) -> list[np.ndarray]:
-    """The pairs of rows of `more` that meet at the folds between two samples: those with no
-    counterpart among `fewer` (the farthest from their nearest row there), paired closest
-    first."""
-    count = (len(more) - len(fewer)) // 2
-    if len(fewer):
-        lone = np.abs(more[:, None, :] - fewer[None, :, :]).max(axis=2).min(axis=1)
-        left = list(np.argsort(-lone, kind="stable")[: 2 * count])
-    else:
-        left = list(range(len(more)))
-    out = []
-    for _ in range(count):
-        if len(left) < 2:
-            break
-        i, j = min(((i, j) for i in left for j in left if i < j),
-                   key=lambda p: np.abs(more[p[0]] - more[p[1]]).max())  # fmt: skip
-        out.append(more[[i, j]])
-        left = [k for k in left if k not in (i, j)]
-    return out
-
-
-def _line_newton(eqs, X: np.ndarray, t: float, spec) -> tuple | None:
-    """Newton on the curve system with (mx, my) held to the line: (z, its line parameter)."""
-    x0, y0, dx, dy = spec
-    start = np.concatenate([X, [x0 + t * dx, y0 + t * dy]])
-    normal = np.zeros(len(start))
-    normal[-2:] = -dy, dx
-    z = newton(eqs, start, start, lambda w: (normal @ (w - start), normal))
-    if z is None:
-        return None
-    return z, float(((z[-2] - x0) * dx + (z[-1] - y0) * dy) / (dx * dx + dy * dy))
 
 
 def _groups(cs: CurveSystem, seed: int) -> list[list[str]]:
@@ -375,9 +255,11 @@ def _degrees(cs: CurveSystem, seed: int, groups: list[list[str]]) -> np.ndarray:
 
 
 def _on(points: np.ndarray, z: np.ndarray, win: Window, nx: int) -> bool:
-    """Whether z lies on a traced polyline: near one of its points in the plane and in X."""
+    """Whether z lies on a traced polyline: near one of its points in the plane and in X (within
+    three steps, which are relative: curve_trace.trace)."""
     near_xy = win.xy_distance(points, z) <= 3 * SPACING * win.diagonal
-    near_x = np.abs(points[:, :nx] - z[:nx]).max(axis=1) <= 3 * HMAX
+    step = HMAX * (1 + np.abs(points).max(axis=1))
+    near_x = np.abs(points[:, :nx] - z[:nx]).max(axis=1) <= 3 * step
     return bool((near_xy & near_x).any())
 
 
@@ -506,44 +388,10 @@ def _cusps(eqs, pts: np.ndarray, win: Window) -> list[tuple[int, np.ndarray]]:
     while k < len(seg) - 1:
         a, b = seg[k], seg[k + 1]
         if norm[k] > 0 and norm[k + 1] > 0 and a @ b < TURN_COS * norm[k] * norm[k + 1]:
-            z = _refine_cusp(eqs, pts[k], pts[k + 2], a / norm[k], win)
+            z = turning_point(eqs, pts[k], pts[k + 2], a / norm[k], win)
             if z is not None:
                 out.append((k + 1, z))
             k += 2
         else:
             k += 1
     return out
-
-
-def _refine_cusp(eqs, za: np.ndarray, zb: np.ndarray, e_in: np.ndarray, win: Window):
-    """Bisection between za and zb on the image's speed along the incoming direction e_in."""
-    from .curve_trace import tangent
-
-    t_a = zb - za
-    t_a /= np.linalg.norm(t_a)
-
-    def at(h: float):
-        pred = za + h * t_a
-        z = newton(eqs, pred, za, lambda w: (t_a @ (w - pred), t_a))
-        if z is None:
-            return None, 0.0
-        t = tangent(eqs, z, za)
-        t = t if t @ t_a > 0 else -t
-        return z, t[win.ix] * win.scale[0] * e_in[0] + t[win.iy] * win.scale[1] * e_in[1]
-
-    lo, hi = 0.0, float(np.linalg.norm(zb - za))
-    z_lo, f_lo = at(lo)
-    z_hi, f_hi = at(hi)
-    if z_lo is None or z_hi is None or f_lo * f_hi > 0:
-        return None
-    for _ in range(50):
-        mid = (lo + hi) / 2
-        z, f = at(mid)
-        if z is None:
-            return None
-        if f * f_lo > 0:
-            lo, f_lo = mid, f
-        else:
-            hi = mid
-        z_hi = z if f * f_lo <= 0 else z_hi
-    return at((lo + hi) / 2)[0]

@@ -1,0 +1,244 @@
+"""Fold points on seed lines from the equilibria along them (framework_folds' "sweep" route).
+
+The seed lines form a grid (LINES vertical and LINES horizontal, the window's edges among
+them). Every equilibrium of the taut set is solved at the grid's crossings (backends.target:
+parameter homotopy from the equilibrium system's generic set, each crossing once for both of
+its lines). Along each line, every real branch of equilibria with positive lengths through a
+crossing is traced by pseudo-arclength continuation on F(X; line(t)) = 0 (curve_trace), to the
+window's edge or until it closes; a crossing's equilibrium on a branch already traced is
+skipped (Newton at the crossing's t from the branch lands on it). A fold on the line is a
+turning point of a branch in t, refined by Newton on the fold system with (x, y) held to the
+line. Not seen: a branch through no crossing (an isola of the line shorter than its grid
+spacing), or a pair of turning points closer together than the trace's steps.
+"""
+
+from __future__ import annotations
+
+from functools import cache
+
+import numpy as np
+
+from ..model.framework.compiled import framework_system, variable_groups
+from ..model.framework.folds import CurveSystem
+from ..model.framework.spec import Framework
+from ..model.framework.units import normalized_slots
+from ..model.polynomial import PolySystem
+from ..settings import Settings, Tolerances
+from .curve_trace import Traced, Window, newton, trace, turning_point
+
+BRANCH_SPACING = 0.02  # a branch's consecutive points: at most this fraction of the line apart
+BRANCH_HMAX = 0.05  # largest step of a branch in (X, x, y), relative to 1 + max |z|
+FLAT = 1e-6  # a branch's step moving t by less than this does not turn it back (noise: 1e-7)
+SAME = 1e-6  # a crossing's equilibrium is on a branch when Newton from it lands this near
+
+
+def sweep_seeds(
+    fw: Framework, cs: CurveSystem, fold_eqs, specs: list, names, settings: Settings
+) -> tuple[list[np.ndarray], list[dict]]:
+    """The fold points on each line (x0, y0, dx, dy) of `specs` (a grid: see the module
+    docstring), as points (X, mx, my), and a record of each line. `fold_eqs`: the curve
+    system's traced equations (curve_trace.Equations); `names`: the map parameters."""
+    solved: dict[tuple[float, float], object] = {}
+    solve = _grid_solver(fw, cs, names, settings, solved)
+    seeds, lines = [], []
+    n = _samples(specs)
+    for spec in specs:
+        ts = np.linspace(0.0, 1.0, n)
+        sols, warm = [], None
+        for t in ts:
+            sols.append(solve(spec, t, warm))
+            warm = sols[-1].warm
+        branches = _branches(cs, spec, ts, [real_points(h) for h in sols])
+        found, counts = _turning_folds(cs, fold_eqs, spec, branches)
+        seeds += found
+        lines.append({
+            "line": list(spec), "points": n, "branches": len(branches),
+            "stalled_ends": sum(e in ("stalled", "max_points") for b in branches for e in b.ends),
+            "real_in_window": len(found), **counts,
+            "lost": int(sum(h.info["lost"] for h in sols)),
+        })  # fmt: skip
+    return seeds, lines
+
+
+def _samples(specs: list) -> int:
+    """Crossings on each line: one per line of the other direction."""
+    vertical = sum(1 for s in specs if s[2] == 0.0)
+    return max(vertical, len(specs) - vertical, 2)
+
+
+def _grid_solver(fw: Framework, cs: CurveSystem, names, settings: Settings, solved: dict):
+    """(spec, t, warm) -> every equilibrium of the taut set at the point t of the line, each
+    point of the plane solved once."""
+    from ..backends.target import solve_parameters
+
+    sx, sy = cs.scales
+    centre = normalized_slots(fw.at_defaults())
+
+    def solve(spec, t: float, warm):
+        x0, y0, dx, dy = spec
+        mx, my = x0 + t * dx, y0 + t * dy
+        key = (round(mx, 12), round(my, 12))
+        if key not in solved:
+            fwp = fw.replace(**{names[0]: mx * sx, names[1]: my * sy})
+            fs = framework_system(fwp, cs.taut)
+            if tuple(fs.ps.variables) != cs.variables:
+                raise AssertionError("the fold system's unknowns differ from the equilibria's")
+            solved[key] = solve_parameters(fs.ps, normalized_slots(fwp), centre, settings,
+                                           variable_groups(fs), warm)  # fmt: skip
+        return solved[key]
+
+    return solve
+
+
+def real_points(hs) -> np.ndarray:
+    """The real endpoints of a solve with every length positive (real parts), one row each: a
+    length never changes sign along a branch (L0 > 0), so only these meet at physical folds."""
+    pts = hs.endpoints.points
+    if not len(pts):
+        return np.zeros((0, pts.shape[1] if pts.ndim == 2 else 0))
+    lengths = [k for k, v in enumerate(hs.endpoints.variables) if v.startswith("d_")]
+    return pts[is_real(pts) & (pts.real[:, lengths] > 0).all(axis=1)].real
+
+
+def is_real(pts: np.ndarray) -> np.ndarray:
+    """Which rows are real: every imaginary part below 1e-6 relative to the real part."""
+    return (np.abs(pts.imag) / (1 + np.abs(pts.real))).max(axis=1) < 1e-6
+
+
+def long_enough(cs: CurveSystem):
+    """z -> whether every length of z = (X, mx, my) is above the solutions' zero-length rule
+    (normalised units): a branch or curve whose length tends to zero leaves the physical
+    equilibria there (its force density grows without bound), so a trace stops."""
+    lengths = [k for k, v in enumerate(cs.variables) if v.startswith("d_")]
+    short = Tolerances().zero_length
+
+    def keep(z: np.ndarray) -> bool:
+        return bool((z[lengths] > short).all())
+
+    return keep
+
+
+def _line_t(z: np.ndarray, spec) -> np.ndarray:
+    """The line parameter of points z (..., N) (their last two coordinates: mx, my)."""
+    x0, y0, dx, dy = spec
+    return ((z[..., -2] - x0) * dx + (z[..., -1] - y0) * dy) / (dx * dx + dy * dy)
+
+
+def _at_t(spec, t: float):
+    """Newton's extra equation holding the line parameter at t."""
+    x0, y0, dx, dy = spec
+
+    def extra(z: np.ndarray):
+        grad = np.zeros(len(z))
+        grad[-2:] = np.array([dx, dy]) / (dx * dx + dy * dy)
+        return _line_t(z, spec) - t, grad
+
+    return extra
+
+
+def _branches(cs: CurveSystem, spec, ts: np.ndarray, reals: list) -> list[Traced]:
+    """Every real branch of the line through a crossing's real equilibria, traced once."""
+    eqs, win = _branch_equations(cs, spec), _line_window(spec)
+    x0, y0, dx, dy = spec
+    keep = long_enough(cs)
+
+    out: list[Traced] = []
+    for t, pts in zip(ts, reals, strict=True):
+        for X in pts:
+            z = np.concatenate([X, [x0 + t * dx, y0 + t * dy]])
+            if not any(_passes_through(eqs, b.points, z, t, spec) for b in out):
+                out.append(trace(eqs, z, win, BRANCH_SPACING, BRANCH_HMAX, keep, relative=True))
+    return out
+
+
+def _passes_through(eqs, points: np.ndarray, z: np.ndarray, t: float, spec) -> bool:
+    """Whether the branch `points` passes through z (at line parameter t): Newton at t from the
+    branch's chords across t lands on z."""
+    tp = _line_t(points, spec)
+    for i in np.flatnonzero((tp[:-1] - t) * (tp[1:] - t) <= 0):
+        span = tp[i + 1] - tp[i]
+        s = 0.5 if span == 0 else (t - tp[i]) / span
+        start = points[i] + s * (points[i + 1] - points[i])
+        if np.abs(start - z).max() > 10 * BRANCH_HMAX:
+            continue
+        w = newton(eqs, start, start, _at_t(spec, t))
+        if w is not None and np.abs(w - z).max() <= SAME * (1 + np.abs(z).max()):
+            return True
+    return False
+
+
+@cache
+def _equilibria(cs: CurveSystem) -> PolySystem:
+    """F(X; mx, my): the curve system's first rows (the fold and switch systems are F plus one)."""
+    n = len(cs.variables)
+    tr = cs.trace
+    return PolySystem(tr.variables, tr.names[:n], tr.exponents[:n], tr.coefficients[:n])
+
+
+def _branch_equations(cs: CurveSystem, spec):
+    """The traced equations of a branch: F = 0 with (mx, my) on the line."""
+    F = _equilibria(cs)
+    x0, y0, dx, dy = spec
+    normal = np.zeros(len(cs.variables) + 2)
+    normal[-2:] = -dy, dx
+
+    def eqs(z: np.ndarray, zref: np.ndarray):
+        value = np.append(F.evaluate(z)[0].real, normal @ z - (-dy * x0 + dx * y0))
+        return value, np.vstack([F.jacobian(z)[0].real, normal])
+
+    return eqs
+
+
+def _line_window(spec) -> Window:
+    """A window holding the line segment: a sliver around its constant coordinate."""
+    x0, y0, dx, dy = spec
+    pad = 1e-9 * (1 + abs(x0) + abs(y0))
+    lo = (min(x0, x0 + dx) - (pad if dx == 0 else 0), min(y0, y0 + dy) - (pad if dy == 0 else 0))
+    hi = (max(x0, x0 + dx) + (pad if dx == 0 else 0), max(y0, y0 + dy) + (pad if dy == 0 else 0))
+    return Window(-2, -1, lo, hi, (1.0, 1.0))
+
+
+def _turning_folds(cs: CurveSystem, fold_eqs, spec, branches: list[Traced]) -> tuple[list, dict]:
+    """The fold points of the branches: where t turns back, located on the branch by bisection
+    and refined by Newton on the fold system `fold_eqs`; with counts of the turns that are
+    relaxed folds (every force density 0: the fold system is singular there, and the relaxed
+    folds have their own) and of those that could not be located or refined."""
+    eqs, win = _branch_equations(cs, spec), _line_window(spec)
+    along = np.array(spec[2:]) / np.hypot(*spec[2:])
+    forces = [k for k, v in enumerate(cs.variables) if v.startswith("w_")]
+    found, counts = [], {"turns": 0, "relaxed": 0, "unrefined": 0}
+    for b in branches:
+        for za, zb in _turns(b, spec):
+            counts["turns"] += 1
+            turn = turning_point(eqs, za, zb, along, win)
+            if turn is not None and forces and np.abs(turn[forces]).max() <= SAME:
+                counts["relaxed"] += 1
+                continue
+            hit = None if turn is None else _line_newton(fold_eqs, turn, spec)
+            if hit is None or np.abs(hit[0] - turn).max() > SAME * (1 + np.abs(turn).max()):
+                counts["unrefined"] += 1
+            elif 0.0 <= hit[1] <= 1.0 and not any(
+                np.abs(hit[0] - f).max() <= SAME * (1 + np.abs(f).max()) for f in found
+            ):
+                found.append(hit[0])
+    return found, counts
+
+
+def _turns(branch: Traced, spec) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The pairs of points of a branch between which t turns back: a change of sign between
+    consecutive steps that move t by more than FLAT (smaller moves are rounding, where a branch
+    crawls towards a zero-length end)."""
+    pts = np.vstack([branch.points, branch.points[1:2]]) if branch.closed else branch.points
+    dt = np.diff(_line_t(pts, spec))
+    moving = np.flatnonzero(np.abs(dt) > FLAT)
+    flips = np.flatnonzero(dt[moving[:-1]] * dt[moving[1:]] < 0)
+    return [(pts[moving[i]], pts[moving[i + 1] + 1]) for i in flips]
+
+
+def _line_newton(eqs, z: np.ndarray, spec) -> tuple | None:
+    """Newton on the curve system from z with (mx, my) held to the line: (z, its t)."""
+    x0, y0, dx, dy = spec
+    normal = np.zeros(len(z))
+    normal[-2:] = -dy, dx
+    w = newton(eqs, z, z, lambda v: (normal @ (v - z), normal))
+    return None if w is None else (w, float(_line_t(w, spec)))

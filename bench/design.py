@@ -30,7 +30,7 @@ def main() -> None:
     ap.add_argument(
         "--with-cotm",
         action="store_true",
-        help="cotm.toml's fold curves too (seeds by sweeps along the lines: minutes)",
+        help="cotm.toml's fold curves too (seeds by sweeps along the lines: about a minute a run)",
     )
     args = ap.parse_args()
     if args.folds_only:
@@ -78,7 +78,7 @@ def _fold_run(fw, x: str, xr: tuple, y: str, yr: tuple) -> tuple[float, float, d
     from cotm_bertini.continuation.framework_folds import framework_fold_curves
 
     t0 = time.perf_counter()
-    _, rec = framework_fold_curves(fw, x, xr, y, yr)
+    _, rec = framework_fold_curves(fw, x, xr, y, yr, workers=2)
     witness = sum(
         r.get("generic_seconds", 0.0) for ts in rec["taut_sets"].values() for r in ts.values()
     )
@@ -99,7 +99,7 @@ def framework_folds(with_cotm: bool = False) -> None:
         fw = cb.Framework.from_toml(f"examples/{name}.toml")
         first, witness, rec = _fold_run(fw, x, xr, y, yr)
         again, _, _ = _fold_run(fw, x, xr, y, yr)
-        print(f"== fold curves of {name}.toml by Bertini, {x} x {y} ==")
+        print(f"== fold curves of {name}.toml by Bertini, {x} x {y}, 2 workers ==")
         print(f"  first run {first:.1f} s (witness sets {witness:.1f} s), again {again:.1f} s; "
               f"{rec['counts']} on {rec['curves_found']} curves")  # fmt: skip
         if name == "cotm":

@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 from framework_physics import scan_critical_points, zeeman_energy
 
@@ -186,6 +187,8 @@ def test_bad_axes_are_refused():
         framework_fold_curves(fw, "x", (1, 0), "y", (0, 1))
     with pytest.raises(ParameterError, match="^seeds: 'lines' is not a seed route"):
         framework_fold_curves(fw, "x", (0, 1), "y", (0, 1), seeds="lines")
+    with pytest.raises(ParameterError, match="^workers = 0: must be an integer >= 1"):
+        framework_fold_curves(fw, "x", (0, 1), "y", (0, 1), workers=0)
 
 
 def test_zeeman_sweep_seeds_find_the_same_diamond():
@@ -212,6 +215,17 @@ def test_zeeman_sweep_seeds_find_the_same_diamond():
     crossings = y[cut] + (0.1 - x[cut]) * (y[cut + 1] - y[cut]) / (x[cut + 1] - x[cut])
     scanned = _scanned_folds_along_x(0.1)
     assert len(crossings) == 2 and np.abs(np.sort(crossings) - np.sort(scanned)).max() < 2e-4
+
+
+def test_zeeman_sweep_route_in_two_processes_is_the_same():
+    """The sweep route's solves, lines and classification in two worker processes give the
+    table of one process, row for row."""
+    fw = cb.Framework.from_toml(EXAMPLES / "zeeman.toml")
+    args = (fw, "x", ZEEMAN_WINDOW[0], "y", ZEEMAN_WINDOW[1])
+    one, rec1 = framework_fold_curves(*args, kinds=("fold",), seeds="sweep")
+    two, rec2 = framework_fold_curves(*args, kinds=("fold",), seeds="sweep", workers=2)
+    assert rec2["workers"] == 2 and len(one) > 500
+    pd.testing.assert_frame_equal(one, two)
 
 
 def _cable_minima(u, n: int = 20000) -> int:
@@ -272,13 +286,16 @@ def test_cotm_relaxed_folds_against_plain_geometry_and_the_closed_form():
     cover it in the window."""
     from cotm_bertini.analysis.fold_curves import fold_curves
     from cotm_bertini.continuation import framework_folds as ff
+    from cotm_bertini.continuation.runner import worker_pool
     from cotm_bertini.model.framework.folds import RELAXED, curve_system
 
     fw = cb.Framework.from_toml(EXAMPLES / "cotm.toml")
     window = (1e-3, 14.0)
     cs = curve_system(fw.replace(L01=7.0, L02=7.0), (), "L01", "L02", RELAXED)
-    curves, info = ff._find(fw, cs, ("L01", window), ("L02", window), cb.Settings(), "auto")
-    table, _, about = ff._rows(fw, curves, "L01", "L02", 0)
+    axes = ("L01", window), ("L02", window)
+    with worker_pool(1) as run:
+        curves, info = ff._find(fw, cs, axes, cb.Settings(), "auto", run)
+        table, _, about = ff._rows(fw, curves, ("L01", "L02"), 0, run)
     assert info["seed_route"] == "witness" and info["lost_paths"] == 0
     assert about["artefacts"] == 0 and len(table) > 500 and table["physical"].all()
     assert table["changes_stable_count"].all() and set(table["kind"]) == {"fold"}

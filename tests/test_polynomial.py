@@ -37,3 +37,19 @@ def test_jacobian_matches_sympy_also_where_coordinates_vanish():
     for k in range(len(z)):
         theirs = np.array(jac(*z[k]), dtype=complex)
         assert np.allclose(ours[k], theirs, rtol=1e-12, atol=1e-12 * np.abs(theirs).max())
+
+
+def test_value_and_jacobian_is_evaluate_and_jacobian():
+    """The one-pass value_and_jacobian gives evaluate's values (sympy's, through lambdify) and
+    the same Jacobian."""
+    rng = np.random.default_rng(5)
+    xs, funcs = _random_system(rng, n_vars=4, n_funcs=3, terms=25)
+    names = tuple(f"f{i}" for i in range(len(funcs)))
+    poly = parametric_from_sympy(tuple(x.name for x in xs), names, tuple(funcs), ()).instantiate([])
+    z = rng.normal(size=(3, len(xs))) + 1j * rng.normal(size=(3, len(xs)))
+    z[2, 1] = 0.0
+    values, jac = poly.value_and_jacobian(z)
+    f = sp.lambdify(xs, funcs, "numpy")
+    theirs = np.array([np.array(f(*row), dtype=complex) for row in z])
+    assert np.allclose(values, theirs, rtol=1e-12, atol=1e-12 * np.abs(theirs).max())
+    assert np.array_equal(jac, poly.jacobian(z))

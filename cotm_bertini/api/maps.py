@@ -161,7 +161,7 @@ def design_map(
 
     (x, xr), (y, yr), points = _axes(model, axes, l01, l02, points)
     t0 = time.perf_counter()
-    folds, fold_record = _fold_curves(model, x, xr, y, yr, settings)
+    folds, fold_record = _fold_curves(model, x, xr, y, yr, settings, workers)
     t_folds = time.perf_counter() - t0
     inside = folds.physical.astype(bool) & folds[x].between(*xr) & folds[y].between(*yr)
     folds = folds[inside].reset_index(drop=True)
@@ -186,7 +186,7 @@ def design_map(
     return DesignMap(model, folds, regions, record, (x, y))
 
 
-def _fold_curves(model, x: str, xr, y: str, yr, settings) -> tuple[pd.DataFrame, dict]:
+def _fold_curves(model, x: str, xr, y: str, yr, settings, workers: int) -> tuple:
     """Every fold point (the paper's: closed form, proved; a framework's: by Bertini), with
     what was done."""
     if isinstance(model, Params):
@@ -195,7 +195,7 @@ def _fold_curves(model, x: str, xr, y: str, yr, settings) -> tuple[pd.DataFrame,
         return fold_curves_proved(model)
     from ..continuation.framework_folds import framework_fold_curves
 
-    return framework_fold_curves(model, x, xr, y, yr, settings)
+    return framework_fold_curves(model, x, xr, y, yr, settings, workers=workers)
 
 
 def _explained(regions: pd.DataFrame, folds: pd.DataFrame, axes, sweep_status: str) -> dict:

@@ -68,6 +68,20 @@ class Traced:
     ends: tuple[str, str]  # "edge", "closed", "looped", "left", "stalled" or "max_points"
 
 
+def remembered(eqs: Equations) -> Equations:
+    """`eqs` keeping its last evaluation: Newton's closing residual and the tangent at the same
+    point then cost one evaluation, not two."""
+    last: dict = {}
+
+    def cached(z: np.ndarray, zref: np.ndarray):
+        key = (z.tobytes(), zref.tobytes())
+        if last.get("key") != key:
+            last.update(key=key, value=eqs(z, zref))
+        return last["value"]
+
+    return cached
+
+
 def newton(eqs: Equations, z: np.ndarray, zref: np.ndarray, extra=None) -> np.ndarray | None:
     """Newton on F = 0 plus one more equation `extra(z) -> (value, gradient)`; None if it fails.
 
@@ -190,11 +204,11 @@ def trace(eqs: Equations, z0: np.ndarray, win: Window, spacing: float = 0.002,
 
 
 def turning_point(eqs: Equations, za: np.ndarray, zb: np.ndarray, direction: np.ndarray,
-                  win: Window) -> np.ndarray | None:  # fmt: skip
+                  win: Window, halvings: int = 50) -> np.ndarray | None:  # fmt: skip
     """The point of the curve between za and zb (near each other on it) where its image in the
     window's plane turns back along `direction` (a unit vector of the plane, user units): by
-    bisection on the sign of the image's velocity along it. None if that sign does not change
-    or Newton fails."""
+    `halvings` bisections on the sign of the image's velocity along it. None if that sign does
+    not change or Newton fails."""
     t_a = zb - za
     t_a /= np.linalg.norm(t_a)
 
@@ -212,7 +226,7 @@ def turning_point(eqs: Equations, za: np.ndarray, zb: np.ndarray, direction: np.
     z_hi, f_hi = at(hi)
     if z_lo is None or z_hi is None or f_lo * f_hi > 0:
         return None
-    for _ in range(50):
+    for _ in range(halvings):
         mid = (lo + hi) / 2
         z, f = at(mid)
         if z is None:

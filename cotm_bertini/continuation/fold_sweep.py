@@ -24,39 +24,34 @@ from ..model.framework.spec import Framework
 from ..model.framework.units import normalized_slots
 from ..model.polynomial import PolySystem
 from ..settings import Settings, Tolerances
-from .curve_trace import Traced, Window, newton, trace, turning_point
+from .curve_trace import Traced, Window, newton, remembered, trace, turning_point
+from .runner import Run
 
 BRANCH_SPACING = 0.02  # a branch's consecutive points: at most this fraction of the line apart
 BRANCH_HMAX = 0.05  # largest step of a branch in (X, x, y), relative to 1 + max |z|
+TURN_HALVINGS = 30  # bisections locating a turn: 1e-9 of a step, then Newton on the fold system
 FLAT = 1e-6  # a branch's step moving t by less than this does not turn it back (noise: 1e-7)
 SAME = 1e-6  # a crossing's equilibrium is on a branch when Newton from it lands this near
 
 
 def sweep_seeds(
-    fw: Framework, cs: CurveSystem, fold_eqs, specs: list, names, settings: Settings
+    fw: Framework, cs: CurveSystem, specs: list, names, settings: Settings, run: Run
 ) -> tuple[list[np.ndarray], list[dict]]:
     """The fold points on each line (x0, y0, dx, dy) of `specs` (a grid: see the module
-    docstring), as points (X, mx, my), and a record of each line. `fold_eqs`: the curve
-    system's traced equations (curve_trace.Equations); `names`: the map parameters."""
-    solved: dict[tuple[float, float], object] = {}
-    solve = _grid_solver(fw, cs, names, settings, solved)
+    docstring), as points (X, mx, my), and a record of each line. `names`: the map parameters;
+    `run`: runs the tasks (runner.worker_pool): the crossings' solves by vertical line, then
+    the lines."""
+    ts = np.linspace(0.0, 1.0, _samples(specs))
+    vertical = [s for s in specs if s[2] == 0.0]  # every crossing lies on one of them
+    solved: dict = {}
+    for part in run(_solve_line, [(fw, cs, spec, ts, names, settings) for spec in vertical]):
+        solved.update(part)
+    tasks = [(cs, spec, ts, [solved[_key(spec, t)] for t in ts]) for spec in specs]
+    results = run(_line_folds, tasks)
     seeds, lines = [], []
-    n = _samples(specs)
-    for spec in specs:
-        ts = np.linspace(0.0, 1.0, n)
-        sols, warm = [], None
-        for t in ts:
-            sols.append(solve(spec, t, warm))
-            warm = sols[-1].warm
-        branches = _branches(cs, spec, ts, [real_points(h) for h in sols])
-        found, counts = _turning_folds(cs, fold_eqs, spec, branches)
+    for found, record in results:
         seeds += found
-        lines.append({
-            "line": list(spec), "points": n, "branches": len(branches),
-            "stalled_ends": sum(e in ("stalled", "max_points") for b in branches for e in b.ends),
-            "real_in_window": len(found), **counts,
-            "lost": int(sum(h.info["lost"] for h in sols)),
-        })  # fmt: skip
+        lines.append(record)
     return seeds, lines
 
 
@@ -66,28 +61,45 @@ def _samples(specs: list) -> int:
     return max(vertical, len(specs) - vertical, 2)
 
 
-def _grid_solver(fw: Framework, cs: CurveSystem, names, settings: Settings, solved: dict):
-    """(spec, t, warm) -> every equilibrium of the taut set at the point t of the line, each
-    point of the plane solved once."""
+def _key(spec, t: float) -> tuple[float, float]:
+    """A point of the plane, as its line gives it (rounded: the two lines through a crossing
+    compute it differently)."""
+    x0, y0, dx, dy = spec
+    return round(x0 + t * dx, 12), round(y0 + t * dy, 12)
+
+
+def _solve_line(task) -> dict:
+    """{point: (its real equilibria with positive lengths, lost paths)} along one line, each
+    continued from the one before when that is proved complete (backends.target)."""
     from ..backends.target import solve_parameters
 
+    fw, cs, spec, ts, names, settings = task
     sx, sy = cs.scales
     centre = normalized_slots(fw.at_defaults())
+    out, warm = {}, None
+    for t in ts:
+        mx, my = _key(spec, t)
+        fwp = fw.replace(**{names[0]: mx * sx, names[1]: my * sy})
+        fs = framework_system(fwp, cs.taut)
+        if tuple(fs.ps.variables) != cs.variables:
+            raise AssertionError("the fold system's unknowns differ from the equilibria's")
+        hs = solve_parameters(fs.ps, normalized_slots(fwp), centre, settings,
+                              variable_groups(fs), warm)  # fmt: skip
+        out[mx, my], warm = (real_points(hs), int(hs.info["lost"])), hs.warm
+    return out
 
-    def solve(spec, t: float, warm):
-        x0, y0, dx, dy = spec
-        mx, my = x0 + t * dx, y0 + t * dy
-        key = (round(mx, 12), round(my, 12))
-        if key not in solved:
-            fwp = fw.replace(**{names[0]: mx * sx, names[1]: my * sy})
-            fs = framework_system(fwp, cs.taut)
-            if tuple(fs.ps.variables) != cs.variables:
-                raise AssertionError("the fold system's unknowns differ from the equilibria's")
-            solved[key] = solve_parameters(fs.ps, normalized_slots(fwp), centre, settings,
-                                           variable_groups(fs), warm)  # fmt: skip
-        return solved[key]
 
-    return solve
+def _line_folds(task) -> tuple[list[np.ndarray], dict]:
+    """One line's fold points (its branches' turns) and its record."""
+    cs, spec, ts, solved = task
+    branches = _branches(cs, spec, ts, [pts for pts, _ in solved])
+    found, counts = _turning_folds(cs, spec, branches)
+    record = {
+        "line": [float(v) for v in spec], "points": len(ts), "branches": len(branches),
+        "stalled_ends": sum(e in ("stalled", "max_points") for b in branches for e in b.ends),
+        "real_in_window": len(found), **counts, "lost": sum(lost for _, lost in solved),
+    }  # fmt: skip
+    return found, record
 
 
 def real_points(hs) -> np.ndarray:
@@ -167,6 +179,16 @@ def _passes_through(eqs, points: np.ndarray, z: np.ndarray, t: float, spec) -> b
     return False
 
 
+def curve_equations(cs: CurveSystem):
+    """The traced equations of z = (X, mx, my): the curve system's residual and Jacobian."""
+
+    def eqs(z: np.ndarray, zref: np.ndarray):
+        F, J = cs.trace.value_and_jacobian(z)
+        return F[0].real, J[0].real
+
+    return remembered(eqs)
+
+
 @cache
 def _equilibria(cs: CurveSystem) -> PolySystem:
     """F(X; mx, my): the curve system's first rows (the fold and switch systems are F plus one)."""
@@ -183,10 +205,11 @@ def _branch_equations(cs: CurveSystem, spec):
     normal[-2:] = -dy, dx
 
     def eqs(z: np.ndarray, zref: np.ndarray):
-        value = np.append(F.evaluate(z)[0].real, normal @ z - (-dy * x0 + dx * y0))
-        return value, np.vstack([F.jacobian(z)[0].real, normal])
+        value, jac = F.value_and_jacobian(z)
+        line = normal @ z - (-dy * x0 + dx * y0)
+        return np.append(value[0].real, line), np.vstack([jac[0].real, normal])
 
-    return eqs
+    return remembered(eqs)
 
 
 def _line_window(spec) -> Window:
@@ -198,19 +221,19 @@ def _line_window(spec) -> Window:
     return Window(-2, -1, lo, hi, (1.0, 1.0))
 
 
-def _turning_folds(cs: CurveSystem, fold_eqs, spec, branches: list[Traced]) -> tuple[list, dict]:
+def _turning_folds(cs: CurveSystem, spec, branches: list[Traced]) -> tuple[list, dict]:
     """The fold points of the branches: where t turns back, located on the branch by bisection
-    and refined by Newton on the fold system `fold_eqs`; with counts of the turns that are
+    and refined by Newton on the fold system; with counts of the turns that are
     relaxed folds (every force density 0: the fold system is singular there, and the relaxed
     folds have their own) and of those that could not be located or refined."""
-    eqs, win = _branch_equations(cs, spec), _line_window(spec)
+    eqs, win, fold_eqs = _branch_equations(cs, spec), _line_window(spec), curve_equations(cs)
     along = np.array(spec[2:]) / np.hypot(*spec[2:])
     forces = [k for k, v in enumerate(cs.variables) if v.startswith("w_")]
     found, counts = [], {"turns": 0, "relaxed": 0, "unrefined": 0}
     for b in branches:
         for za, zb in _turns(b, spec):
             counts["turns"] += 1
-            turn = turning_point(eqs, za, zb, along, win)
+            turn = turning_point(eqs, za, zb, along, win, TURN_HALVINGS)
             if turn is not None and forces and np.abs(turn[forces]).max() <= SAME:
                 counts["relaxed"] += 1
                 continue

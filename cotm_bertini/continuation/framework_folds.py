@@ -56,13 +56,16 @@ from ..model.framework.spec import Framework
 from ..model.framework.units import normalized_slots, units
 from ..settings import Settings, Tolerances
 from .curve_trace import Traced, Window, trace, turning_point
-from .fold_sweep import is_real, long_enough, sweep_seeds
+from .fold_sweep import curve_equations, is_real, long_enough, sweep_seeds
+from .runner import Run, worker_pool
 
 SEED_ROUTES = ("auto", "witness", "sweep")
 WITNESS_MAX_PATHS = 600  # "auto": above this many paths the fold witness set is not solved
 SPACING = 0.002  # consecutive points of a curve: at most this fraction of the window diagonal
 LINES = 9  # seed lines in each direction (the window's edges among them)
 HMAX = 0.05  # largest step in (X, mx, my), normalised units, relative to 1 + max |z|
+CHUNK = 250  # points classified in one task (a worker's share)
+NULL_BATCH = 16  # points whose null_cubic is evaluated together
 TURN_COS = -0.5  # image segments turning by more than 120 deg: a cusp between them
 CUSP_TOL = 1e-6  # |w . F_XX[v, v]| / |F_XX[v, v]| below this confirms a cusp
 
@@ -86,12 +89,14 @@ def framework_fold_curves(
     settings: Settings | None = None,
     kinds: tuple[str, ...] = ("fold", "cable_switch"),
     seeds: str = "auto",
+    workers: int = 1,
 ) -> tuple[pd.DataFrame, dict]:
     """Fold curves, cusps and cable switches of `fw` in the window xrange x yrange of its
     parameters xname, yname: one row a point (docs/columns.md, "framework folds") and the record
     for run.json. `kinds`: which curves to compute (fold curves bring their cusps); `seeds`:
     how points on the seed lines are found ("witness", "sweep" or "auto", module docstring;
-    relaxed folds always by their witness set, which the record says)."""
+    relaxed folds always by their witness set, which the record says); `workers`: processes for
+    the sweep route's solves and lines and for classifying the points."""
     settings = settings or Settings()
     _check(fw, xname, xrange, yname, yrange)
     if seeds not in SEED_ROUTES:
@@ -105,29 +110,38 @@ def framework_fold_curves(
     centre = fw.replace(**{xname: sum(xrange) / 2, yname: sum(yrange) / 2})
     frames, record = [], {"taut_sets": {}}
     next_id = 0
-    for taut in taut_sets(centre):
-        if framework_system(centre, taut).free:
-            continue  # moves freely: no isolated equilibria, so no folds (continuum_check's job)
-        cables = [c for c in taut if normalized_slots(centre)[f"L0_{c}"] != 0]
-        chosen = ([""] if "fold" in kinds else []) + (cables if "cable_switch" in kinds else [])
-        if "fold" in kinds and relaxed_applies(centre, taut):
-            chosen.insert(1, RELAXED)
-        for cable in chosen:
-            cs = curve_system(centre, taut, xname, yname, cable)
-            curves, info = _find(fw, cs, (xname, xrange), (yname, yrange), settings, seeds)
-            frame, next_id, about = _rows(fw, curves, xname, yname, next_id)
-            frames.append(frame)
-            name = {"": "fold", RELAXED: "relaxed fold"}.get(cable, f"switch {cable}")
-            record["taut_sets"].setdefault(" ".join(taut) or "none", {})[name] = {**info, **about}
+    with worker_pool(workers) as run:
+        for taut in taut_sets(centre):
+            if framework_system(centre, taut).free:
+                continue  # moves freely: no isolated equilibria, so no folds (continuum_check's)
+            for cable in _curve_kinds(centre, taut, kinds):
+                cs = curve_system(centre, taut, xname, yname, cable)
+                axes = (xname, xrange), (yname, yrange)
+                curves, info = _find(fw, cs, axes, settings, seeds, run)
+                frame, next_id, about = _rows(fw, curves, (xname, yname), next_id, run)
+                frames.append(frame)
+                name = {"": "fold", RELAXED: "relaxed fold"}.get(cable, f"switch {cable}")
+                group = record["taut_sets"].setdefault(" ".join(taut) or "none", {})
+                group[name] = {**info, **about}
     table = pd.concat(frames, ignore_index=True) if frames else _empty(fw, xname, yname)
     record.update(
         window={xname: list(xrange), yname: list(yrange)}, spacing=SPACING, lines=LINES,
-        kinds=list(kinds), seeds=seeds,
+        kinds=list(kinds), seeds=seeds, workers=workers,
         seed=settings.seed, seconds=time.perf_counter() - t0,
         counts={k: int((table["kind"] == k).sum()) for k in ("fold", "cusp", "cable_switch")},
         curves_found=int(table.loc[table["curve_id"] >= 0, "curve_id"].nunique()),
     )  # fmt: skip
     return table, record
+
+
+def _curve_kinds(centre: Framework, taut: tuple[str, ...], kinds: tuple[str, ...]) -> list[str]:
+    """The curve systems of a taut set, as curve_system's `cable`: "" (folds), RELAXED (relaxed
+    folds, where they can occur), and each taut cable with L0 > 0 (its switch)."""
+    cables = [c for c in taut if normalized_slots(centre)[f"L0_{c}"] != 0]
+    chosen = ([""] if "fold" in kinds else []) + (cables if "cable_switch" in kinds else [])
+    if "fold" in kinds and relaxed_applies(centre, taut):
+        chosen.insert(1, RELAXED)
+    return chosen
 
 
 def _check(fw: Framework, xname: str, xrange, yname: str, yrange) -> None:
@@ -154,15 +168,6 @@ def _centre(cs: CurveSystem, fw: Framework, xname: str, yname: str) -> dict:
     return {n: line[n] for n in cs.ps.parameters}
 
 
-def _equations(cs: CurveSystem):
-    """The traced equations of z = (X, mx, my): the curve system's residual and Jacobian."""
-
-    def eqs(z: np.ndarray, zref: np.ndarray):
-        return cs.trace.evaluate(z)[0].real, cs.trace.jacobian(z)[0].real
-
-    return eqs
-
-
 def _line_seeds(cs, gs, win: Window, settings) -> tuple[list, list[dict]]:
     """Real points of the curve on LINES vertical and LINES horizontal lines of the window."""
     seeds, lines = [], []
@@ -184,9 +189,9 @@ def _line_seeds(cs, gs, win: Window, settings) -> tuple[list, list[dict]]:
     return seeds, lines
 
 
-def _find(fw: Framework, cs: CurveSystem, xaxis, yaxis, settings, seeds: str) -> tuple:
+def _find(fw: Framework, cs: CurveSystem, axes, settings, seeds: str, run: Run) -> tuple:
     """Seeds on lines (by the chosen route), and every curve through a seed traced once."""
-    (xname, xrange), (yname, yrange) = xaxis, yaxis
+    (xname, xrange), (yname, yrange) = axes
     t0 = time.perf_counter()
     sx, sy = cs.scales
     nz = len(cs.variables)
@@ -207,10 +212,10 @@ def _find(fw: Framework, cs: CurveSystem, xaxis, yaxis, settings, seeds: str) ->
     else:
         t1 = time.perf_counter()
         specs = _line_specs(win)
-        seeds_found, lines = sweep_seeds(fw, cs, _equations(cs), specs, (xname, yname), settings)
+        seeds_found, lines = sweep_seeds(fw, cs, specs, (xname, yname), settings, run)
         info.update(sweep_points=lines[0]["points"])
     t2 = time.perf_counter()
-    eqs = _equations(cs)
+    eqs = curve_equations(cs)
     traced, skipped = [], 0
     lengths = [k for k, v in enumerate(cs.variables) if v.startswith("d_")]
     for z in seeds_found:
@@ -320,54 +325,69 @@ def _index(fs, fwp: Framework, X: np.ndarray) -> tuple[int, bool]:
     return int((rest < 0).sum()), bool(zero)
 
 
-def _null_cubic(cs: CurveSystem, eqs, z: np.ndarray) -> float:
-    """|w . F_XX[v, v]| / |F_XX[v, v]| at a fold point (v, w: unit right and left null vectors
-    of J_X F; F_XX[v, v] by central differences): zero at a cusp, not at an ordinary fold."""
+def _null_cubics(cs: CurveSystem, pts: np.ndarray) -> np.ndarray:
+    """|w . F_XX[v, v]| / |F_XX[v, v]| at fold points, the rows of pts (v, w: unit right and
+    left null vectors of J_X F; F_XX[v, v] by central differences): zero at a cusp, not at an
+    ordinary fold. Vectorised over the points, NULL_BATCH at a time (memory: terms x points)."""
     n = len(cs.variables)
-    _, J = eqs(z, z)
-    u, _, vt = np.linalg.svd(J[:n, :n])
-    v, w = vt[-1], u[:, -1]
-    h = 1e-5
-    shift = np.concatenate([h * v, [0.0, 0.0]])
-    q = (eqs(z + shift, z)[1][:n, :n] - eqs(z - shift, z)[1][:n, :n]) @ v / (2 * h)
-    return float(abs(w @ q) / max(np.linalg.norm(q), 1e-300))
+    out = []
+    for batch in np.array_split(pts, -(-len(pts) // NULL_BATCH)):
+        J = cs.trace.jacobian(batch).real[:, :n, :n]
+        u, _, vt = np.linalg.svd(J)
+        v, w = vt[:, -1, :], u[:, :, -1]
+        h = 1e-5
+        shift = np.concatenate([h * v, np.zeros((len(batch), 2))], axis=1)
+        Jpm = cs.trace.jacobian(np.concatenate([batch + shift, batch - shift])).real
+        q = np.einsum("kij,kj->ki", Jpm[: len(batch), :n, :n] - Jpm[len(batch) :, :n, :n], v)
+        q /= 2 * h
+        out.append(np.abs((w * q).sum(axis=1)) / np.maximum(np.linalg.norm(q, axis=1), 1e-300))
+    return np.concatenate(out) if out else np.zeros(0)
 
 
-def _rows(fw: Framework, curves: _Curves, xname: str, yname: str, next_id: int) -> tuple:
+def _rows(fw: Framework, curves: _Curves, names, next_id: int, run: Run) -> tuple:
     """The table of one curve system's curves (physical points only, a curve split where it
     stops being physical), the next free curve_id, and counts for the record."""
     cs, win = curves.cs, curves.window
     kind = "cable_switch" if cs.kind == "switch" else "fold"  # a relaxed fold is a fold
+    parts = [np.array_split(c.points, -(-len(c.points) // CHUNK)) for c in curves.traced]
+    done = iter(run(_classify_points, [(fw, cs, pts, names) for ps in parts for pts in ps]))
     rows, artefacts, cusps = [], 0, 0
-    for curve in curves.traced:
-        classified = [_classify(fw, cs, z, xname, yname) for z in curve.points]
-        if cs.kind == "fold":
-            for r, z in zip(classified, curve.points, strict=True):
-                r["null_cubic"] = _null_cubic(cs, curves.eqs, z)
+    for curve, ps in zip(curves.traced, parts, strict=True):
+        classified = [r for _ in ps for r in next(done)]
         artefacts += sum(r["changes_stable_count"] is None for r in classified)
         keep = np.array([r["physical"] and r["changes_stable_count"] is not None
                          for r in classified])  # fmt: skip
-        for run in _runs(keep):
-            pts = curve.points[run]
+        for piece in _runs(keep):
+            pts = curve.points[piece]
             arc = np.concatenate([[0.0], np.cumsum(win.xy_distance(pts[1:], pts[:-1]))])
             arc /= win.diagonal
-            for k, i in enumerate(run):
+            for k, i in enumerate(piece):
                 rows.append({**classified[i], "curve_id": next_id, "arc": arc[k], "kind": kind})
             if cs.kind == "fold":
                 for k, z in _cusps(curves.eqs, pts, win):
-                    row = _classify(fw, cs, z, xname, yname)
+                    row = _classify_points((fw, cs, z[None, :], names))[0]
                     if row["physical"]:
                         cusps += 1
-                        rows.append({**row, "curve_id": next_id, "arc": arc[k], "kind": "cusp",
-                                     "null_cubic": _null_cubic(cs, curves.eqs, z)})  # fmt: skip
+                        rows.append({**row, "curve_id": next_id, "arc": arc[k], "kind": "cusp"})
             next_id += 1
-    frame = pd.DataFrame(rows) if rows else _empty(fw, xname, yname)
+    frame = pd.DataFrame(rows) if rows else _empty(fw, *names)
     if "null_cubic" not in frame:
         frame["null_cubic"] = np.nan
     frame["taut"] = " ".join(cs.taut) or "none"
     about = {"curves_traced": len(curves.traced), "points": len(frame), "artefacts": artefacts,
              "cusps": cusps}  # fmt: skip
-    return frame[list(_empty(fw, xname, yname).columns)], next_id, about
+    return frame[list(_empty(fw, *names).columns)], next_id, about
+
+
+def _classify_points(task) -> list[dict]:
+    """_classify of each point (rows of pts), with null_cubic on a fold curve (a task: it may
+    run in a worker process)."""
+    fw, cs, pts, (xname, yname) = task
+    rows = [_classify(fw, cs, z, xname, yname) for z in pts]
+    if cs.kind == "fold":
+        for r, c in zip(rows, _null_cubics(cs, pts), strict=True):
+            r["null_cubic"] = float(c)
+    return rows
 
 
 def _runs(keep: np.ndarray) -> list[np.ndarray]:

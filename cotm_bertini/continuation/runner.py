@@ -8,6 +8,7 @@ already stored. `sweep.csv` is assembled from the points at the end.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import sys
@@ -272,13 +273,32 @@ def _execute(
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
-    ctx = mp.get_context(_start_method())
+    ctx = mp.get_context(start_method())
     with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
         for fut in as_completed([pool.submit(_run_task, t) for t in tasks]):
             yield from fut.result()
 
 
-def _start_method() -> str:
+Run = Callable[[Callable, list], list]  # run(function, tasks) -> the results, in order
+
+
+@contextlib.contextmanager
+def worker_pool(workers: int) -> Iterator[Run]:
+    """A `Run` in this process (workers = 1) or in `workers` processes, started as the sweeps'
+    are (start_method); the tasks and the function must pickle."""
+    check_workers(workers)
+    if workers == 1:
+        yield lambda fn, tasks: [fn(t) for t in tasks]
+        return
+    import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor
+
+    ctx = mp.get_context(start_method())
+    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+        yield lambda fn, tasks: list(pool.map(fn, tasks))
+
+
+def start_method() -> str:
     """How worker processes start: `fork` while this process has not loaded the bertini module
     and runs no other thread (the workers then begin with numpy, this package and the generic
     sets already loaded), else `spawn` (the bertini module is not fork-safe with its threads)."""

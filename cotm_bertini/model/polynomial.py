@@ -160,6 +160,10 @@ class PolySystem:
 
     def jacobian(self, x: np.ndarray) -> np.ndarray:
         """Jacobian at the rows of x, shape (n_points, n_functions, n_variables)."""
+        return self.value_and_jacobian(x)[1]
+
+    def value_and_jacobian(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """evaluate(x) and jacobian(x) in one pass over the terms."""
         x = np.atleast_2d(np.asarray(x, dtype=complex))
         exps, coefs, starts, top = self._flat
         n, m = x.shape
@@ -167,12 +171,14 @@ class PolySystem:
         cols = np.arange(m)
         factors = pw[:, cols, exps]  # (n, T, m): x_v^e_tv
         # d/dx_v of a term: coeff e_tv x_v^(e_tv - 1) times the product of its other factors,
-        # that product from exclusive prefix and suffix products: O(T m), not O(T m^2).
+        # that product from exclusive prefix and suffix products: O(T m), not O(T m^2); the
+        # last prefix product times the last factor is the term itself.
         ones = np.ones((n, len(coefs), 1), dtype=complex)
         left = np.concatenate([ones, np.cumprod(factors[:, :, :-1], axis=2)], axis=2)
         right = np.concatenate([np.cumprod(factors[:, :, :0:-1], axis=2)[:, :, ::-1], ones], axis=2)
         lowered = exps * pw[:, cols, np.maximum(exps - 1, 0)]
-        return self._sum_terms(left * right * lowered * coefs[:, None], starts)
+        values = self._sum_terms(left[:, :, -1] * factors[:, :, -1] * coefs, starts)
+        return values, self._sum_terms(left * right * lowered * coefs[:, None], starts)
 
     def scale(self) -> np.ndarray:
         """Largest coefficient magnitude of each function, to make residuals relative."""

@@ -155,6 +155,7 @@ def _one_way(eqs: Equations, z0: np.ndarray, t0: np.ndarray, win: Window, spacin
     ("looped": it entered a loop through a junction, which it would go round for ever), out of
     `keep`, or stuck."""
     out, z, t = [], z0, t0
+    seen = np.empty((MAX_POINTS, len(z0)))  # out as an array, for the loop test
     h = _step_size(t, win, spacing, hmax)
     travelled = 0.0
     while len(out) < MAX_POINTS:
@@ -180,8 +181,9 @@ def _one_way(eqs: Equations, z0: np.ndarray, t0: np.ndarray, win: Window, spacin
         travelled += np.linalg.norm(new - z)
         if travelled > 3 * h and _passes(z, new, z0, h):
             return out, "closed"
-        if len(out) > 3 and _passes(z, new, np.array(out[:-3]), h):
+        if len(out) > 3 and _passes(z, new, seen[: len(out) - 3], h):
             return out, "looped"
+        seen[len(out)] = new
         out.append(new)
         z, t = new, t_new
     return out, "max_points"

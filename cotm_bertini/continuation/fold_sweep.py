@@ -97,7 +97,9 @@ def _line_folds(task) -> tuple[list[np.ndarray], dict]:
     record = {
         "line": [float(v) for v in spec], "points": len(ts), "branches": len(branches),
         "stalled_ends": sum(e in ("stalled", "max_points") for b in branches for e in b.ends),
-        "real_in_window": len(found), **counts, "lost": sum(lost for _, lost in solved),
+        "real_in_window": len(found), **counts,
+        # Each crossing's solve is counted once, on its vertical line (sweep_seeds solves it).
+        "lost": sum(lost for _, lost in solved) if spec[2] == 0.0 else 0,
     }  # fmt: skip
     return found, record
 

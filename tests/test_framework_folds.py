@@ -33,6 +33,27 @@ def _scanned_folds_along_x(x: float) -> list[float]:
     return out
 
 
+def test_determinant_by_minors_is_sympys():
+    """The fold condition's determinant (expansion by minors over the polynomial ring, which
+    takes float coefficients as they come) equals sympy's Berkowitz determinant, up to 7 x 7,
+    with zero entries and float coefficients."""
+    import sympy as sp
+    from sympy.polys.matrices import DomainMatrix
+
+    from cotm_bertini.model.framework.folds import _det_by_minors
+
+    rng = np.random.default_rng(11)
+    x, y, z = sp.symbols("x y z")
+    pool = [0, 1, x, y - 2, z * x + 3, sp.Float(0.25) * y * z, sp.Float(-1.5)]
+    point = {x: 0.3, y: -0.7, z: 1.1}
+    for n in (1, 2, 3, 5, 7):
+        M = sp.Matrix(n, n, lambda i, j: pool[rng.integers(len(pool))])
+        dm = DomainMatrix.from_Matrix(M)
+        ours = dm.domain.to_sympy(_det_by_minors(dm))
+        theirs = M.det(method="berkowitz")
+        assert abs(complex(ours.subs(point)) - complex(theirs.subs(point))) < 1e-9, n
+
+
 def test_fold_condition_vanishes_at_the_scanned_folds_only():
     """The fold system's extra equation (the bordered Hessian's determinant cleared of 1/d),
     evaluated at the double roots of the independent V' along x = 0.1 and at its ordinary

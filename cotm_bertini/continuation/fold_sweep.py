@@ -43,6 +43,7 @@ def sweep_seeds(
     the lines."""
     ts = np.linspace(0.0, 1.0, _samples(specs))
     vertical = [s for s in specs if s[2] == 0.0]  # every crossing lies on one of them
+    run(_generic_sets, [(fw, cs, settings)])  # once, on disk, before the workers need them
     solved: dict = {}
     for part in run(_solve_line, [(fw, cs, spec, ts, names, settings) for spec in vertical]):
         solved.update(part)
@@ -66,6 +67,21 @@ def _key(spec, t: float) -> tuple[float, float]:
     compute it differently)."""
     x0, y0, dx, dy = spec
     return round(x0 + t * dx, 12), round(y0 + t * dy, 12)
+
+
+def _generic_sets(task) -> None:
+    """Solve (or load) the equilibrium system's two generic sets that every crossing's solve
+    starts from (backends.target.solve_parameters), so that parallel workers find them cached
+    rather than each solving them."""
+    from ..backends.homotopy import SECOND_START, generic_set
+
+    fw, cs, settings = task
+    fs = framework_system(fw.at_defaults(), cs.taut)
+    slots = normalized_slots(fw.at_defaults())
+    centre = {n: slots[n] for n in fs.ps.parameters}
+    for seed in (settings.seed, settings.seed + SECOND_START):
+        generic_set(fs.ps, seed, centre=centre, groups=variable_groups(fs),
+                    scheduler=settings.scheduler)  # fmt: skip
 
 
 def _solve_line(task) -> dict:

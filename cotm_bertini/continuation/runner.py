@@ -284,8 +284,9 @@ Run = Callable[[Callable, list], list]  # run(function, tasks) -> the results, i
 
 @contextlib.contextmanager
 def worker_pool(workers: int) -> Iterator[Run]:
-    """A `Run` in this process (workers = 1) or in `workers` processes, started as the sweeps'
-    are (start_method); the tasks and the function must pickle."""
+    """A `Run` in this process (workers = 1) or in `workers` processes, started at the first
+    run as the sweeps' are (start_method: by then this process may have loaded the bertini
+    module, and must not fork); the tasks and the function must pickle."""
     check_workers(workers)
     if workers == 1:
         yield lambda fn, tasks: [fn(t) for t in tasks]
@@ -293,9 +294,19 @@ def worker_pool(workers: int) -> Iterator[Run]:
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor
 
-    ctx = mp.get_context(start_method())
-    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
-        yield lambda fn, tasks: list(pool.map(fn, tasks))
+    pools: list[ProcessPoolExecutor] = []
+
+    def run(fn: Callable, tasks: list) -> list:
+        if not pools:
+            ctx = mp.get_context(start_method())
+            pools.append(ProcessPoolExecutor(max_workers=workers, mp_context=ctx))
+        return list(pools[0].map(fn, tasks))
+
+    try:
+        yield run
+    finally:
+        for pool in pools:
+            pool.shutdown()
 
 
 def start_method() -> str:

@@ -238,8 +238,9 @@ FRAMEWORK = {
     "length)",
     "index": "physical rows: the number of negative reduced-Hessian eigenvalues (-1 otherwise)",
     "reason": "why a row is not physical: complex, negative_length:NAME, cable_pushes:NAME (a "
-    "taut cable shorter than L0), slack_cable_stretched:NAME (a slack one longer); empty if "
-    "physical",
+    "taut cable shorter than L0), slack_cable_stretched:NAME (a slack one longer), "
+    "switch_duplicate:NAME (an equilibrium with cable NAME at its free length, found by both "
+    "taut sets: this is the second row of it); empty if physical",
     "hess_min_eig": "the smallest reduced-Hessian eigenvalue (the framework's units)",
     "max_imag": "the largest |Im| / (1 + |Re|) over the unknowns",
     "residual": "max |f_i| of the polynomial system at the refined point (framework's units)",

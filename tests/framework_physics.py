@@ -89,16 +89,29 @@ def _grad_hess(f, x, h=1e-5):
     return g, H
 
 
+def hessian_eigenvalues(f, x) -> np.ndarray:
+    """The eigenvalues of f's central-difference Hessian at x (ascending)."""
+    return np.linalg.eigvalsh(_grad_hess(f, np.asarray(x, float))[1])
+
+
 def gradient_norm(f, x) -> float:
     """|grad f| at x by central differences."""
     return float(np.linalg.norm(_grad_hess(f, np.asarray(x, float))[0]))
 
 
 def fourbar_energy(theta, branch: int, ex=1.0, ey=2.0, L0=0.5):
-    """V of examples/fourbar.toml at crank angle theta on one assembly branch (+1 or -1):
-    the coupler's tip meets the rocker's where the circles |C - B| = 2.2, |C - D| = 1.5 cross."""
+    """V of examples/fourbar.toml at crank angle theta on one assembly branch (+1 or -1)."""
     scalar = np.ndim(theta) == 0
-    theta = np.atleast_1d(np.asarray(theta, float))
+    B, p = fourbar_points(np.atleast_1d(np.asarray(theta, float)), branch)
+    lift = np.hypot(p[0] - ex, p[1] - ey)
+    tie = np.hypot(B[0] + 1.0, B[1] + 1.0)
+    V = 1.0 / 2 * np.maximum(lift - L0, 0) ** 2 + 2.0 / 2 * tie**2
+    return V[0] if scalar else V
+
+
+def fourbar_points(theta: np.ndarray, branch: int) -> tuple[np.ndarray, np.ndarray]:
+    """The crank's tip B and the coupler's cable point p (2 x n) at crank angles theta: the
+    coupler's tip meets the rocker's where the circles |C - B| = 2.2, |C - D| = 1.5 cross."""
     B = np.stack([np.cos(theta), np.sin(theta)])
     D = np.array([2.0, 0.0])[:, None]
     gap = D - B
@@ -109,11 +122,7 @@ def fourbar_energy(theta, branch: int, ex=1.0, ey=2.0, L0=0.5):
     normal = np.stack([-unit[1], unit[0]])
     C = B + along * unit + branch * across * normal
     u = (C - B) / 2.2
-    p = B + 1.1 * u + 0.5 * np.stack([-u[1], u[0]])
-    lift = np.hypot(p[0] - ex, p[1] - ey)
-    tie = np.hypot(B[0] + 1.0, B[1] + 1.0)
-    V = 1.0 / 2 * np.maximum(lift - L0, 0) ** 2 + 2.0 / 2 * tie**2
-    return V[0] if scalar else V
+    return B, B + 1.1 * u + 0.5 * np.stack([-u[1], u[0]])
 
 
 def fourbar_branch(crank_deg, coupler_deg) -> int:

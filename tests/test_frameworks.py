@@ -12,6 +12,7 @@ from conftest import ROOT
 from framework_physics import (
     fourbar_branch,
     fourbar_energy,
+    fourbar_points,
     gradient_norm,
     grid_minima,
     pendulum_energy,
@@ -221,3 +222,27 @@ def test_fourbar_against_a_scan_of_both_assembly_branches():
         _match(found["crank.angle_deg"], [np.degrees(t) for t, _ in crit], 1e-6)
         mins = [np.degrees(t) for t, kind in crit if kind == "min"]
         _match(found[found["stable"].astype(bool)]["crank.angle_deg"], mins, 1e-6)
+
+
+@pytest.mark.parametrize("shift", [0.0, 4e-6])
+def test_fourbar_equilibrium_at_the_lift_switch_is_one_row(shift):
+    """The crank at 45 deg (the tie's maximum, lift slack) with the lift's anchor placed 0.5
+    (+ shift) from the coupler's cable point, found independently: the lift is at (or within
+    the borderline tolerance of) its free length there, so both taut sets find the equilibrium.
+    It is one physical row (the other kept, not physical, as a switch duplicate), and the
+    physical count equals a scan's."""
+    t = np.radians(45.0)
+    _, p = fourbar_points(np.array([t]), 1)
+    ex, ey = p[0, 0] + (0.5 + shift) * 0.6, p[1, 0] + (0.5 + shift) * 0.8
+    res = cb.solve(cb.Framework.from_toml(EXAMPLES / "fourbar.toml").replace(ex=ex, ey=ey))
+    phys = res.physical
+    at = phys[_angle_gap(phys["crank.angle_deg"].to_numpy(), 45.0) < 1e-3]
+    assert len(at) == 1 and at["kind"].iloc[0] == "degenerate", at
+    table = res.table
+    assert (table["reason"] == "switch_duplicate:lift").sum() == 1
+    crit = [
+        kind
+        for b in (1, -1)
+        for _, kind in scan_critical_points(lambda x, b=b: fourbar_energy(x, b, ex, ey))
+    ]
+    assert len(phys) == len(crit) and int(phys["stable"].sum()) == crit.count("min")

@@ -7,26 +7,59 @@ import numpy as np
 from ..model.framework.compiled import FrameworkSystem, framework_system, slot_vector
 from ..model.framework.spec import Framework
 from ..model.framework.structure import layout
-from ..model.framework.units import normalized_slots
+from ..model.framework.units import normalized_slots, units
 from ..settings import Settings
 from .framework_classify import column_names, positions
 
 _GROUP_KEYS = ("physical", "is_real")
+SWITCH_POSE_TOL = 1e-3  # two rows of one equilibrium at a switch: poses this close (length unit)
 
 
 def order_rows(fw: Framework, parts: list[dict]) -> dict[str, np.ndarray]:
-    """The rows of every taut set in one table: physical, then real, then complex; within a
-    group by energy, then by the pose columns; ids 1, 2, ... in that order."""
+    """The rows of every taut set in one table (an equilibrium at a cable's switch found by two
+    taut sets: one physical row, _merge_switch_pairs): physical, then real, then complex;
+    within a group by energy, then by the pose columns; ids 1, 2, ... in that order."""
     names = column_names(fw)
     if not parts:
         return {n: np.zeros(0) for n in names}
     cols = {n: np.concatenate([p[n] for p in parts]) for n in names if n != "solution_id"}
+    _merge_switch_pairs(fw, cols)
     group = np.where(cols["physical"], 0, np.where(cols["is_real"], 1, 2))
     pose = [np.round(cols[n], 9) for n in reversed(names[1:4]) if n in cols]
     order = np.lexsort((*pose, np.round(cols["energy"], 9), group))
     out = {"solution_id": np.arange(1, len(order) + 1)}
     out.update({n: cols[n][order] for n in names if n != "solution_id"})
     return out
+
+
+def _merge_switch_pairs(fw: Framework, cols: dict) -> None:
+    """An equilibrium with a cable within the borderline tolerance of its free length is found
+    by both taut sets, with the cable taut and slack, both rows `degenerate` at nearly one pose
+    (a count of two for one equilibrium). Of such a pair the row whose cable state holds (taut
+    and not shorter than L0, or slack and not longer) stays physical, the taut one if both do;
+    the other is kept as not physical, reason `switch_duplicate:<cable>` (in place)."""
+    near = np.flatnonzero(cols["physical"] & (cols["kind"] == "degenerate"))
+    if len(near) < 2:
+        return
+    unit = units(fw)[0]
+    xyz = [n for n in cols if n.endswith((".x", ".y", ".z"))]
+    pose = np.stack([cols[n][near] for n in xyz], axis=1) / unit
+    sets = [set(cols["taut_set"][i].split()) for i in near]
+    L0 = fw.slots()
+    for a in range(len(near)):
+        for b in range(a + 1, len(near)):
+            (i, j), diff = near[[a, b]], sets[a] ^ sets[b]
+            if len(diff) != 1 or np.abs(pose[a] - pose[b]).max() > SWITCH_POSE_TOL:
+                continue
+            (cable,) = diff
+            if not (cols["physical"][i] and cols["physical"][j]):
+                continue  # one of them already stands for a pair
+            taut, slack = (i, j) if cable in sets[a] else (j, i)
+            stretch = cols[f"{cable}.length"][[taut, slack]] - L0[f"L0_{cable}"]
+            gone = taut if stretch[0] < 0 <= -stretch[1] else slack
+            cols["physical"][gone] = cols["stable"][gone] = False
+            cols["kind"][gone] = ""
+            cols["reason"][gone] = f"switch_duplicate:{cable}"
 
 
 def framework_counts(table: dict, report: dict) -> dict:

@@ -266,6 +266,12 @@ def test_zeeman_cables_switch_curve_against_a_scan():
     )
     assert record["kinds"] == ["cable_switch"] and set(table["kind"]) == {"cable_switch"}
     assert len(table) > 100 and table["physical"].all()
+    # At the corner (0.8, 0.2) u is 0.217 from the rim's circle, less than the band's free
+    # length 0.25: band_u can go slack there though never at the window's centre, so the taut
+    # set {band_p} is the window's. Its equations hold neither x nor y: no curve, and said so.
+    assert np.hypot(0.8 - 1.0, 0.2) > 0.5 - 0.25 and ZEEMAN_WINDOW == ((-0.6, 0.8), (-0.8, 0.2))
+    alone = record["taut_sets"]["band_p"]["switch band_p"]
+    assert alone["curves_traced"] == 0 and "neither x nor y" in alone["why"]
     rows = table.sort_values(["curve_id", "arc"]).reset_index(drop=True)
     for k in range(1, len(rows) - 1, max(1, len(rows) // 8)):
         row = rows.iloc[k]

@@ -12,7 +12,15 @@ import numpy as np
 import pandas as pd
 import pytest
 from conftest import run_cli
-from framework_physics import zeeman_energy
+from framework_physics import (
+    fourbar_branch,
+    fourbar_energy,
+    gradient_norm,
+    hessian_eigenvalues,
+    pendulum_energy,
+    scan_critical_points,
+    zeeman_energy,
+)
 
 import cotm_bertini as cb
 from cotm_bertini.analysis.region_changes import count_changes, unexplained
@@ -192,8 +200,8 @@ def test_map_framework_writes_the_map(zeeman_cli):
 # ---- make stress: the completeness check on two-body and closed-loop frameworks --------------
 
 STRESS_MAPS = {
-    "double_pendulum": ("weight", (0.0, 1.0), "L0", (0.2, 1.0)),
-    "fourbar": ("ex", (0.0, 2.0), "ey", (1.0, 3.0)),
+    "double_pendulum": ("weight", (0.0, 3.0), "L0", (0.05, 1.0)),
+    "fourbar": ("ex", (2.0, 4.0), "ey", (1.5, 4.0)),
 }
 
 
@@ -209,3 +217,48 @@ def test_map_count_changes_are_explained_stress(name):
     assert rec["sweep_status"] == "ok"
     assert rec["unexplained_changes"] == 0, rec["unexplained"]
     assert m.status == "ok"
+    # Windows where the stable count changes (else the check above could not fail).
+    assert rec["count_changes"] > 0 and len(m.folds)
+    if name == "fourbar":
+        _fourbar_against_the_loop(m)
+    else:
+        _pendulum_folds_against_the_torus(m)
+
+
+def _pendulum_folds_against_the_torus(m) -> None:
+    """Each fold row of the double pendulum is a degenerate critical point of its energy on the
+    torus in closed form (tests/framework_physics.py): gradient and one Hessian eigenvalue 0."""
+    assert set(m.folds.kind) <= {"fold", "cusp"}
+    for _, row in m.folds.iterrows():
+        th = np.radians([row["link1.angle_deg"], row["link2.angle_deg"]])
+
+        def V(a, b, row=row):
+            return pendulum_energy(a, b, weight=row.weight, L0=row.L0)
+
+        assert gradient_norm(V, th) < 1e-6, (row.weight, row.L0)
+        assert np.abs(hessian_eigenvalues(V, th)).min() < 1e-4, (row.weight, row.L0)
+
+
+def _fourbar_against_the_loop(m) -> None:
+    """The four-bar's map against its energy on the two assembly circles in closed form
+    (tests/framework_physics.py): the grid's counts against scans, each fold row a degenerate
+    critical point, each switch row a critical point with the lift cable at its free length."""
+    for r in m.regions.itertuples():
+        crit = [kind for b in (1, -1)
+                for _, kind in scan_critical_points(
+                    lambda t, b=b, r=r: fourbar_energy(t, b, r.ex, r.ey), n=50_000)]  # fmt: skip
+        assert (r.physical, r.stable) == (len(crit), crit.count("min")), (r.ex, r.ey)
+    h = 1e-4
+    for _, row in m.folds.iterrows():
+        b = fourbar_branch(row["crank.angle_deg"], row["coupler.angle_deg"])
+        t, u = np.radians(row["crank.angle_deg"]), (row.ex, row.ey)
+        # Small steps for the slope: at a switch V'' jumps, which a step h would see.
+        slope = (fourbar_energy(t + 1e-7, b, *u) - fourbar_energy(t - 1e-7, b, *u)) / 2e-7
+        assert abs(slope) < 1e-6, (u, slope)
+        if row.kind != "cable_switch":  # a fold or a cusp: a degenerate critical point
+            V = [fourbar_energy(t + k * h, b, *u) for k in (-1, 0, 1)]
+            curvature = (V[2] - 2 * V[1] + V[0]) / h**2
+            assert abs(curvature) < 1e-4, (u, curvature)
+        else:  # the lift cable at 0.5: its energy at L0 = 0 is lift^2 / 2, at L0 = 100 none
+            lift = fourbar_energy(t, b, *u, L0=0.0) - fourbar_energy(t, b, *u, L0=100.0)
+            assert abs(np.sqrt(2 * lift) - 0.5) < 1e-6, (u, lift)

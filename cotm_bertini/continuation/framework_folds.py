@@ -67,6 +67,7 @@ HMAX = 0.05  # largest step in (X, mx, my), normalised units, relative to 1 + ma
 CHUNK = 250  # points classified in one task (a worker's share)
 NULL_BATCH = 16  # points whose null_cubic is evaluated together
 TURN_COS = -0.5  # image segments turning by more than 120 deg: a cusp between them
+TAUT_GRID = 9  # points per axis where the window's taut sets are enumerated
 CUSP_TOL = 1e-6  # |w . F_XX[v, v]| / |F_XX[v, v]| below this confirms a cusp
 
 
@@ -104,24 +105,29 @@ def framework_fold_curves(
     for kind in kinds:
         if kind not in ("fold", "cable_switch"):
             raise ParameterError(f"kinds: {kind!r} is not a curve kind (fold, cable_switch)")
-    from ..point import taut_sets
-
     t0 = time.perf_counter()
     centre = fw.replace(**{xname: sum(xrange) / 2, yname: sum(yrange) / 2})
     frames, record = [], {"taut_sets": {}}
     next_id = 0
     with worker_pool(workers) as run:
-        for taut in taut_sets(centre):
+        for taut in _window_taut_sets(fw, xname, xrange, yname, yrange):
             if framework_system(centre, taut).free:
                 continue  # moves freely: no isolated equilibria, so no folds (continuum_check's)
             for cable in _curve_kinds(centre, taut, kinds):
                 cs = curve_system(centre, taut, xname, yname, cable)
+                name = {"": "fold", RELAXED: "relaxed fold"}.get(cable, f"switch {cable}")
+                group = record["taut_sets"].setdefault(" ".join(taut) or "none", {})
+                if not cs.ps.parameters:
+                    # Neither map parameter enters: its equilibria are the same all over the
+                    # window, so a fold would fill the plane (never, generically) or be absent,
+                    # and its witness system has a free line parameter (no isolated points).
+                    group[name] = {"curves_traced": 0, "points": 0, "why": "its equations "
+                                   f"involve neither {xname} nor {yname}"}  # fmt: skip
+                    continue
                 axes = (xname, xrange), (yname, yrange)
                 curves, info = _find(fw, cs, axes, settings, seeds, run)
                 frame, next_id, about = _rows(fw, curves, (xname, yname), next_id, run)
                 frames.append(frame)
-                name = {"": "fold", RELAXED: "relaxed fold"}.get(cable, f"switch {cable}")
-                group = record["taut_sets"].setdefault(" ".join(taut) or "none", {})
                 group[name] = {**info, **about}
     table = pd.concat(frames, ignore_index=True) if frames else _empty(fw, xname, yname)
     record.update(
@@ -132,6 +138,20 @@ def framework_fold_curves(
         curves_found=int(table.loc[table["curve_id"] >= 0, "curve_id"].nunique()),
     )  # fmt: skip
     return table, record
+
+
+def _window_taut_sets(fw: Framework, xname: str, xrange, yname: str, yrange) -> list[tuple]:
+    """The taut sets that can occur somewhere in the window: those of any of TAUT_GRID x
+    TAUT_GRID points of it (corners included; a cable always taut at the centre may go slack
+    near an edge), all taut first as point.taut_sets orders them."""
+    from ..point import taut_sets
+
+    found: set[tuple[str, ...]] = set()
+    for x in np.linspace(*xrange, TAUT_GRID):
+        for y in np.linspace(*yrange, TAUT_GRID):
+            found.update(taut_sets(fw.replace(**{xname: float(x), yname: float(y)})))
+    order = [c.name for c in fw.cables]
+    return sorted(found, key=lambda t: (-len(t), [order.index(c) for c in t]))
 
 
 def _curve_kinds(centre: Framework, taut: tuple[str, ...], kinds: tuple[str, ...]) -> list[str]:

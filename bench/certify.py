@@ -24,8 +24,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests" / "stres
 
 def one(params, label: str, torus: bool) -> dict:
     """Solve (homotopy engine, no cache) and certify one parameter set, both timed."""
-    from cotm_bertini.analysis.certify import certify_table
-    from cotm_bertini.analysis.certify_search import _cover
+    from cotm_bertini.analysis.certify.mechanism import certify_table
+    from cotm_bertini.analysis.certify.search import _cover
     from cotm_bertini.point import solve_point
 
     solve_point(params)  # warm: generic set and generated code loaded
@@ -64,7 +64,7 @@ FRAMEWORKS = {"zeeman": {"x": 0.1, "y": -0.25}, "zeeman_cables": {"x": 1.45, "y"
 def one_framework(name: str) -> dict:
     """Solve (generic sets warm, no cache) and certify one example framework, both timed."""
     import cotm_bertini as cb
-    from cotm_bertini.analysis.certify_framework import certify_framework_table
+    from cotm_bertini.analysis.certify.framework import certify_framework_table
     from cotm_bertini.point import solve_framework_point
 
     root = Path(__file__).resolve().parent.parent

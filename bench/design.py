@@ -19,8 +19,8 @@ import cotm_bertini as cb
 
 
 def main() -> None:
-    from cotm_bertini.analysis.certify_curve import certify_samples
-    from cotm_bertini.analysis.fold_curves import _grid, parallel_samples
+    from cotm_bertini.analysis.certify.curve import certify_samples
+    from cotm_bertini.analysis.design.fold_curves import _grid, parallel_samples
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--points", type=int, default=41, help="grid points a side of the map")
@@ -90,7 +90,7 @@ def framework_folds(with_cotm: bool = False) -> None:
     issue's window, and with `with_cotm` cotm.toml over (0, 14]^2 against the closed-form
     route's time on the built-in model (target: at most 10 times it), each run twice (the
     witness sets solved, or loaded from the cache, then in memory)."""
-    from cotm_bertini.analysis.fold_curves import fold_curves_proved
+    from cotm_bertini.analysis.design.fold_curves import fold_curves_proved
 
     runs = [("zeeman", "x", (-0.6, 0.8), "y", (-0.8, 0.2))]
     if with_cotm:

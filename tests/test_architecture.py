@@ -114,3 +114,17 @@ def test_docs_column_reference_is_current():
 
     docs = PACKAGE.parent / "docs" / "columns.md"
     assert docs.read_text() == document()
+
+
+def test_every_subpackage_ships_in_the_wheel():
+    """pyproject.toml lists its packages by hand: each folder of the package with an __init__.py
+    must be among them (else an installed, non-editable copy lacks it)."""
+    import tomllib
+
+    listed = set(tomllib.loads((PACKAGE.parent / "pyproject.toml").read_text())["tool"][
+        "setuptools"]["packages"])  # fmt: skip
+    found = {
+        p.parent.relative_to(PACKAGE.parent).as_posix().replace("/", ".")
+        for p in PACKAGE.rglob("__init__.py")
+    }
+    assert found <= listed, sorted(found - listed)

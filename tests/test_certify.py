@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import cotm_bertini as cb
-from cotm_bertini.analysis.certify import certify_table
+from cotm_bertini.analysis.certify.mechanism import certify_table
 from cotm_bertini.analysis.critical_points import critical_points
 from cotm_bertini.point import solve_point
 
@@ -104,7 +104,7 @@ def test_cli_certify_and_exit_4(tmp_path, monkeypatch):
     rec = json.loads((tmp_path / "latest" / "run.json").read_text())
     assert rec["certificate"]["proved_equilibria"] == 4
 
-    from cotm_bertini.analysis import certify as certify_module
+    from cotm_bertini.analysis.certify import mechanism as certify_module
     from cotm_bertini.cli.main import main
 
     real = certify_module.certify_table

@@ -1,9 +1,9 @@
 """The parallel curve's certified cover (issue 17, goals 3 and 4): the cover holds the curve
-(checked against the double-precision sampler of analysis.design, another code path), the
-completeness search along it agrees with the two-dimensional branch and bound over the torus,
-and both proofs fail when what they check is wrong: an equilibrium dropped from the table (one
-with a spring of 6e-3 L3, in the narrow region the search must resolve; a relaxed one), a row
-given twice, samples of the curve removed."""
+(checked against the double-precision sampler of analysis.design.free_lengths, another code path),
+the completeness search along it agrees with the two-dimensional branch and bound over the torus,
+and both proofs fail when what they check is wrong: an equilibrium dropped from the table (one with
+a spring of 6e-3 L3, in the narrow region the search must resolve; a relaxed one), a row given
+twice, samples of the curve removed."""
 
 from __future__ import annotations
 
@@ -16,11 +16,11 @@ import pandas as pd
 import pytest
 
 import cotm_bertini as cb
-from cotm_bertini.analysis.certify import certify_table
-from cotm_bertini.analysis.certify_curve import certify_samples
-from cotm_bertini.analysis.certify_search import COVER_CELLS, GEOMETRY, _cover
-from cotm_bertini.analysis.design import parallel_cross, parallel_roots
-from cotm_bertini.analysis.fold_curves import _grid, parallel_samples
+from cotm_bertini.analysis.certify.curve import certify_samples
+from cotm_bertini.analysis.certify.mechanism import certify_table
+from cotm_bertini.analysis.certify.search import COVER_CELLS, GEOMETRY, _cover
+from cotm_bertini.analysis.design.fold_curves import _grid, parallel_samples
+from cotm_bertini.analysis.design.free_lengths import parallel_cross, parallel_roots
 from cotm_bertini.point import solve_point
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "stress"))

@@ -12,7 +12,7 @@ from conftest import ROOT, run_cli
 from framework_physics import pendulum_energy, scan_critical_points, zeeman_energy
 
 import cotm_bertini as cb
-from cotm_bertini.analysis.certify_framework import certify_framework_table
+from cotm_bertini.analysis.certify.framework import certify_framework_table
 
 # These share the cold generic sets of the costly examples (fourbar, double pendulum,
 # cotm.toml): one xdist worker runs them in turn, so each set is solved once.

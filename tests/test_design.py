@@ -12,7 +12,7 @@ import pandas as pd
 import pytest
 
 import cotm_bertini as cb
-from cotm_bertini.analysis.design import parallel_curve, parallel_sine
+from cotm_bertini.analysis.design.free_lengths import parallel_curve, parallel_sine
 from cotm_bertini.model.compiled import energy_gradient, energy_hessian
 from cotm_bertini.model.kinematics import zero_length_poses
 

@@ -99,8 +99,8 @@ def test_stable_count_changes_only_across_fold_curves(folds):
     """Completeness on the paper geometry: wherever direct solves on neighbouring grid points
     disagree on the number of stable equilibria, a fold curve crosses the segment between them
     (41 x 41 over (0, 14] with COTM_STRESS=full, 11 x 11 otherwise). The check is the one of
-    every framework's map (analysis.region_changes), on the paper's sampled curve."""
-    from cotm_bertini.analysis.region_changes import count_changes, grid_window, uncrossed
+    every framework's map (analysis.design.region_changes), on the paper's sampled curve."""
+    from cotm_bertini.analysis.design.region_changes import count_changes, grid_window, uncrossed
 
     n = 41 if os.environ.get("COTM_STRESS") == "full" else 11
     lo = 14.0 / n

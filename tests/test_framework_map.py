@@ -23,7 +23,7 @@ from framework_physics import (
 )
 
 import cotm_bertini as cb
-from cotm_bertini.analysis.region_changes import count_changes, unexplained
+from cotm_bertini.analysis.design.region_changes import count_changes, unexplained
 from cotm_bertini.api.maps import grid_values
 
 pytestmark = pytest.mark.xdist_group("framework_examples")  # the Zeeman fold sets: solved once

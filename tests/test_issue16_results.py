@@ -243,7 +243,7 @@ def test_6_first_generic_solve_says_what_once_and_shows_progress(tmp_path):
 def test_7_certify_of_a_cached_solve_reports_its_own_time(tmp_path, monkeypatch, capsys):
     """certify of a cached solve: the solve's time is labelled cached, the cache line gives the
     look-up's time (not the proof's), and run.json keeps the two apart."""
-    import cotm_bertini.analysis.certify as certify_module
+    import cotm_bertini.analysis.certify.mechanism as certify_module
     from cotm_bertini.cli.main import main
 
     assert main(["solve", "case1", "--no-plots", "--quiet", "--out", str(tmp_path)]) == 0

@@ -26,7 +26,7 @@ import pandas as pd
 from ..model.compiled import energy, energy_gradient, energy_hessian
 from ..params import Params
 from .critical_points import deg_distance
-from .design import generalised_forces
+from .design.free_lengths import generalised_forces
 
 KICK = 1e-3  # rad: the first step off the saddle, along the unstable eigenvector
 MAX_STEP = 0.02  # rad

@@ -24,11 +24,11 @@ def certify(res: Solutions, strict: bool = True):
     """
     table = res.table.reset_index(drop=True)  # rows by position
     if isinstance(res.params, Params):
-        from ..analysis.certify import certify_table
+        from ..analysis.certify.mechanism import certify_table
 
         cert = certify_table(res.params, table)
     else:
-        from ..analysis.certify_framework import certify_framework_table
+        from ..analysis.certify.framework import certify_framework_table
 
         cert = certify_framework_table(res.params, table)
     res.attach_certificate(cert)

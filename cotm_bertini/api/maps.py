@@ -190,7 +190,7 @@ def _fold_curves(model, x: str, xr, y: str, yr, settings, workers: int) -> tuple
     """Every fold point (the paper's: closed form, proved; a framework's: by Bertini), with
     what was done."""
     if isinstance(model, Params):
-        from ..analysis.fold_curves import fold_curves_proved
+        from ..analysis.design.fold_curves import fold_curves_proved
 
         return fold_curves_proved(model)
     from ..continuation.framework_folds import framework_fold_curves
@@ -201,7 +201,7 @@ def _fold_curves(model, x: str, xr, y: str, yr, settings, workers: int) -> tuple
 def _explained(regions: pd.DataFrame, folds: pd.DataFrame, axes, sweep_status: str) -> dict:
     """The map's completeness check: the stable-count changes between grid neighbours that no
     fold curve changing the count (or cable switch) crosses; incomplete if any."""
-    from ..analysis.region_changes import count_changes, unexplained
+    from ..analysis.design.region_changes import count_changes, unexplained
 
     missed, tolerance = unexplained(regions, folds, *axes)
     listed = missed.head(UNEXPLAINED_LISTED)

@@ -377,7 +377,7 @@ def design(args: argparse.Namespace) -> int:
     """`design`: the free lengths holding a pose, printed (and one CSV row with --out)."""
     import pandas as pd
 
-    from ..analysis.design import design as design_pose
+    from ..analysis.design.free_lengths import design as design_pose
     from ..fs import write_csv
 
     params = params_from(args)

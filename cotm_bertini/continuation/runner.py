@@ -140,11 +140,11 @@ def _certify_point(params: Params, solved: PointSolution, cols: dict) -> None:
     """Prove the point (columns certified, certified_radius, certificate, certify_seconds); a
     point whose proof is not complete is `incomplete`."""
     if isinstance(params, Params):
-        from ..analysis.certify import certify_table
+        from ..analysis.certify.mechanism import certify_table
 
         cert = certify_table(params, solved.columns)
     else:  # a framework (docs/certify.md, "Frameworks")
-        from ..analysis.certify_framework import certify_framework_table
+        from ..analysis.certify.framework import certify_framework_table
 
         cert = certify_framework_table(params, solved.columns)
     n = len(cols["point"])

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from flint import arb
 
-from ..params import Params
+from ...params import Params
 
 TWO_PI = 2 * math.pi
 
@@ -282,7 +282,7 @@ def certify_samples(params: Params, samples: list, grid: np.ndarray,
     grid lines), every crossing of a leaf edge isolated, and each one found among the samples.
     Crossings the samples lack are added (bisected in double precision). Returns the run.json
     `certificate` record and the samples with any additions."""
-    from ..versions import dist_version
+    from ...versions import dist_version
 
     start = time.perf_counter()
     sp = springs(params)
@@ -343,7 +343,7 @@ def _add_missing(params: Params, samples: list, grid: np.ndarray, found: Crossin
 
 def _bisect(params: Params, axis: int, x: float, lo: float, hi: float) -> float:
     """The root of a_1 x a_2 on the line of `axis` through x, in [lo, hi] (double precision)."""
-    from .design import parallel_cross
+    from ..design.free_lengths import parallel_cross
 
     def f(t: float) -> float:
         return float(parallel_cross(params, x, t) if axis == 0 else parallel_cross(params, t, x))

@@ -25,8 +25,8 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from ..params import PARAM_NAMES, Params
-from .energy_terms import gradient_hessian
+from ...params import PARAM_NAMES, Params
+from ..energy_terms import gradient_hessian
 
 TWO_PI = 2 * math.pi
 ROOT_MIN_WIDTH = 1e-10  # boxes holding a known equilibrium's enclosure are split down to this
@@ -169,7 +169,7 @@ def _where(bounds: tuple[list[int], np.ndarray], q: tuple) -> tuple[list[int], l
 
 def spring_length_squares(params: Params, pa, g1, g2) -> list:
     """Balls holding d_i^2 over the box, for each spring with L0 > 0 (where V is not smooth)."""
-    from ..model.kinematics import spring_vectors
+    from ...model.kinematics import spring_vectors
 
     vec = spring_vectors(pa, g1.cos(), g1.sin(), g2.cos(), g2.sin())
     free = {1: params.L01, 2: params.L02}

@@ -17,10 +17,10 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from ..errors import ParameterError
-from ..model.kinematics import dot, spring_jacobian, spring_vectors
-from ..params import Params
-from .energy_terms import gradient_hessian
+from ...errors import ParameterError
+from ...model.kinematics import dot, spring_jacobian, spring_vectors
+from ...params import Params
+from ..energy_terms import gradient_hessian
 
 PARALLEL = 1e-9  # |a_1 x a_2| / (|a_1| |a_2|) below this: the pose is on the parallel curve
 ZERO_LENGTH = 1e-9  # a spring shorter than this (relative to L3) has no direction

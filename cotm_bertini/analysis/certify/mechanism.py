@@ -1,15 +1,15 @@
 """The certificate: every reported solution proved, and the physical set proved complete.
 
 1. Each row of the solutions table: Krawczyk in complex ball arithmetic on the polynomial system
-   (`certify_roots`): a unique solution in a small box, real where the table says real.
+   (`certify/roots`): a unique solution in a small box, real where the table says real.
 2. Each physical equilibrium: Krawczyk on grad V = 0 in the angles (a tiny box), and its kind
    from the interval Hessian over that box (positive definite: a minimum, stable).
-3. Completeness (`certify_search`): every critical point of V whose spring lengths exceed the
+3. Completeness (`certify/search`): every critical point of V whose spring lengths exceed the
    reported bound is relaxed (both springs at their free lengths: a branch and bound on that
-   polynomial system) or lies on the parallel curve a_1 x a_2 = 0 (enclosed by `certify_curve`,
+   polynomial system) or lies on the parallel curve a_1 x a_2 = 0 (enclosed by `certify/curve`,
    then searched along in one variable); each lies in one of the boxes of step 2.
    `method="torus"` runs the earlier two-dimensional branch and bound over the torus instead
-   (`certify_torus`, slower; an independent route for the tests).
+   (`certify/torus`, slower; an independent route for the tests).
 Any difference from the table -- a critical point it lacks, a physical row not proved, a kind
 that differs -- is a contradiction: the certificate says so and the caller raises.
 """
@@ -22,10 +22,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..params import Params
-from .certify_roots import certify_rows
-from .certify_search import Known, search
-from .certify_torus import arb_params, box, branch_and_bound, enclosures, krawczyk_2d
+from ...params import Params
+from .roots import certify_rows
+from .search import Known, search
+from .torus import arb_params, box, branch_and_bound, enclosures, krawczyk_2d
 
 SHORT = 1e-3  # springs shorter than this (times L3) are set aside: V is not smooth at length 0
 MIN_WIDTH = 1e-4  # radians: the smallest box away from a known equilibrium
@@ -67,7 +67,7 @@ class Certificate:
 
     def record(self) -> dict:
         """The run.json `certificate` block."""
-        from ..versions import dist_version
+        from ...versions import dist_version
 
         return {
             "status": self.status,
@@ -169,7 +169,7 @@ def _completeness(params: Params, known: list[Known], short: float, min_width: f
         return search(params, known, short, min_width)
     if method != "torus":
         raise ValueError(f"method {method!r}: 'curve' or 'torus'")
-    from .certify_curve import interval
+    from .curve import interval
 
     balls = {k.sid: (interval(*k.enclosure[:2]), interval(*k.enclosure[2:])) for k in known}
     return branch_and_bound(params, balls, short, min_width)

@@ -3,13 +3,13 @@
 1. Each real row: the solver's variables recovered from the row (pose, lengths, tensions; the
    multipliers the table does not list by a least-squares solve, exact since the equations are
    affine in them), then Krawczyk in ball arithmetic on its taut set's own polynomial system
-   (`certify_roots`, the same code as for the paper's mechanism), the parameters entering as
+   (`certify/roots`, the same code as for the paper's mechanism), the parameters entering as
    balls that hold the file's values in the framework's units.
 2. Each proved physical row: its consistency (every length variable > 0, a taut cable longer
    than its free length, a slack one shorter) and its kind (the inertia of the reduced Hessian,
-   `certify_inertia`) over the proved box.
+   `certify/inertia`) over the proved box.
 3. Where the poses form a circle or a torus (with cables too: V piecewise, `_TorusV`):
-   completeness by the branch and bound of `certify_torus` on V in the body angles, enclosed by
+   completeness by the branch and bound of `certify/torus` on V in the body angles, enclosed by
    the derivation's own generated code evaluated on balls (model.framework.ballcode).
 Elsewhere the certificate says what is proved (the rows) and that completeness is not.
 """
@@ -24,16 +24,16 @@ from dataclasses import dataclass, field
 import numpy as np
 from flint import arb
 
-from ..model.framework.ballcode import ball_module
-from ..model.framework.compiled import FrameworkSystem, framework_system, variable_scale
-from ..model.framework.spec import Framework
-from ..model.framework.structure import layout
-from ..model.framework.units import normalized_slots, slot_kind, units
-from .certify import Certificate, duplicates, kind_differences
-from .certify_inertia import reduced_kind
-from .certify_roots import WORKING_BITS, ball_system_of, certify_points
-from .certify_search import Known
-from .certify_torus import Landscape, krawczyk_box, torus_search
+from ...model.framework.ballcode import ball_module
+from ...model.framework.compiled import FrameworkSystem, framework_system, variable_scale
+from ...model.framework.spec import Framework
+from ...model.framework.structure import layout
+from ...model.framework.units import normalized_slots, slot_kind, units
+from .inertia import reduced_kind
+from .mechanism import Certificate, duplicates, kind_differences
+from .roots import WORKING_BITS, ball_system_of, certify_points
+from .search import Known
+from .torus import Landscape, krawczyk_box, torus_search
 
 SHORT = 1e-3  # springs shorter than this (framework length units) are set aside at cone points
 MIN_WIDTH = 1e-4  # radians: the smallest box away from a known equilibrium
@@ -361,7 +361,7 @@ def certify_framework_table(
 
 
 def _enclosure_balls(bounds: tuple) -> tuple:
-    from .certify_torus import box
+    from .torus import box
 
     return box(*bounds)
 

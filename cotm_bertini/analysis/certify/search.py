@@ -5,7 +5,7 @@ grad V = sum_i k_i (1 - L0_i/d_i) a_i, so a critical point is relaxed (d_i = L0_
 springs, both with free lengths) or lies on the parallel curve C (a_1 x a_2 = 0): off C the a_i
 are independent and both weights must vanish. Two searches, each complete for its kind:
 
-1. **Along C** (`certify_curve`): C is covered by leaves in each of which it is the graph of a
+1. **Along C** (`certify/curve`): C is covered by leaves in each of which it is the graph of a
    function of one angle. Each leaf's parameter interval is bisected; above a piece I, interval
    Newton steps on f = a_1 x a_2 in the other angle (its derivative there excludes 0 over the
    leaf) enclose every point of C in a thin box I x J. A thin box is decided like a box of the
@@ -33,8 +33,8 @@ from functools import lru_cache
 
 from flint import arb
 
-from ..params import Params
-from .certify_curve import (
+from ...params import Params
+from .curve import (
     Springs,
     cross,
     cross_and_slopes,

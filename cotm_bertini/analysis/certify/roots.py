@@ -15,8 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model.compiled import parametric_system, polynomial_system
-from ..params import LENGTHS, PARAM_NAMES, Params
+from ...model.compiled import parametric_system, polynomial_system
+from ...params import LENGTHS, PARAM_NAMES, Params
 
 RADII = (1e-12, 1e-10, 1e-8, 1e-6)  # tried in turn, relative to 1 + |c|
 WORKING_BITS = 128  # the centre is polished by Newton at this precision first

@@ -1,9 +1,9 @@
 """Fold curves in the (L01, L02) plane, from the structure of the equilibrium set.
 
 Every equilibrium with a tensioned spring lies on the parallel curve a_1 x a_2 = 0 of the torus
-(analysis.design), and there its free lengths lie on a line: with u the common direction of a_1,
-a_2 and w_i = a_i . u, l_i = L0_i / d_i = 1 + t c_i with c = (k2 w2, -k1 w1). Along that line the
-energy Hessian is affine in t,
+(analysis.design.free_lengths), and there its free lengths lie on a line: with u the common
+direction of a_1, a_2 and w_i = a_i . u, l_i = L0_i / d_i = 1 + t c_i with c = (k2 w2,
+-k1 w1). Along that line the energy Hessian is affine in t,
     H(t) = sum_i k_i l_i w_i^2 / d_i^2 u u^T + sum_i k_i (1 - l_i) B_i,
 so det H(t) is a quadratic: each pose on the parallel curve carries at most two fold points, and
 the fold curves are the image of the parallel curve under those roots. The parallel curve does
@@ -19,11 +19,11 @@ from itertools import product
 import numpy as np
 import pandas as pd
 
-from ..model.kinematics import spring_jacobian, spring_second_derivatives, spring_vectors
-from ..params import Params
-from .critical_points import deg_distance
-from .design import generalised_forces, parallel_cross, parallel_roots
-from .energy_terms import curvature
+from ...model.kinematics import spring_jacobian, spring_second_derivatives, spring_vectors
+from ...params import Params
+from ..critical_points import deg_distance
+from ..energy_terms import curvature
+from .free_lengths import generalised_forces, parallel_cross, parallel_roots
 
 FOLD_COLUMNS = [
     "L01", "L02", "gamma1_deg", "gamma2_deg", "d1", "d2", "physical", "family", "curve_id",
@@ -112,9 +112,9 @@ def fold_curves(params: Params, points: int = 1500) -> pd.DataFrame:
 
 def fold_curves_proved(params: Params, points: int = 1500) -> tuple[pd.DataFrame, dict]:
     """`fold_curves` from samples proved to leave no part of the parallel curve out
-    (`certify_curve.certify_samples`: crossings the sampler missed are added), and the
+    (`certify/curve.certify_samples`: crossings the sampler missed are added), and the
     certificate (the run.json `certificate` record of the map)."""
-    from .certify_curve import certify_samples
+    from ..certify.curve import certify_samples
 
     record, samples = certify_samples(params, parallel_samples(params, points), _grid(points))
     return _folds(params, samples, points), record
@@ -140,7 +140,7 @@ def zero_length_ends(table: pd.DataFrame, length_unit: float) -> pd.DataFrame:
     .zero_length times L3) get kind `zero_length` and are not physical: V is not smooth there
     (a spring with a free length at zero length), so a fold curve running into that point ends
     there; it neither folds nor turns back in a cusp."""
-    from ..settings import Tolerances
+    from ...settings import Tolerances
 
     lengths = table[["d1", "d2"]].to_numpy(float)
     short = (lengths < Tolerances().zero_length * length_unit).any(axis=1)

@@ -7,6 +7,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from ..model.framework.spec import Framework
+from .common import set_title, values_line
 from .energy_map import KIND_STYLE
 
 
@@ -39,8 +40,9 @@ def barrier_profile_figure(fw: Framework, table: pd.DataFrame, paths: dict) -> F
     ax.set_xlabel("arc length from the saddle along the descent (rad and length units; "
                   "- towards min_a, + towards min_b)")  # fmt: skip
     ax.set_ylabel("V (J)")
-    values = ", ".join(f"{k} = {v:g}" for k, v in fw.as_dict().items())
-    ax.set_title(
+    values = values_line(fw.as_dict())
+    set_title(
+        ax,
         f"Energy along the descents from each saddle ({fw.name}"
         + (f": {values}" if values else "") + ")\nminima labelled with their solution_id",
         fontsize=10,

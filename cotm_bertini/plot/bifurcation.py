@@ -14,7 +14,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from ..params import PARAM_NAMES, PARAM_UNITS, TABLE1
-from .common import flag, param_label, save
+from .common import flag, param_label, save, set_title
 
 # Styles of the bifurcation diagram: line width and style, marker size (points^2).
 _SWEEP_LINE = {"stable": (2.6, "-"), "unstable": (1.1, (0, (5, 2.5))), "nonphysical": (0.7, "-")}
@@ -320,14 +320,14 @@ def bifurcation_figure(
         ax.set_yticks(np.arange(0, 361, 45))
         ax.set_ylabel(f"{name} (deg)")
         ax.grid(True, lw=0.3, alpha=0.6)
-        ax.set_title(f"{name} of the equilibria against {param}", fontsize=10)
+        set_title(ax, f"{name} of the equilibria against {param}", fontsize=10)
     if len(values):
         pad = 0.01 * (values[-1] - values[0]) if len(values) > 1 else 0.5
         axes[1].set_xlim(values[0] - pad, values[-1] + pad)
     axes[1].set_xlabel(param_label(param))
     _legend(fig, has_branches, dense, show_all, events)
     title = _title(sweep, param, values, has_branches)
-    fig.suptitle(title + _fixed_line(fixed, param), fontsize=10)
+    set_title(fig, title + _fixed_line(fixed, param), fontsize=10)
     return fig
 
 

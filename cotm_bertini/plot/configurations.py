@@ -13,7 +13,7 @@ from matplotlib.patches import Patch
 
 from ..model.kinematics import points
 from ..params import Params
-from .common import describe, physical_rows, save
+from .common import describe, fit_text, physical_rows, save, set_title
 
 COLOURS = {
     "bottom": "tab:red",
@@ -54,7 +54,7 @@ def zigzag(a: np.ndarray, b: np.ndarray, amplitude: float, coils: int = 6) -> np
 
 
 def _no_equilibrium(params: Params) -> Figure:
-    fig = Figure(figsize=(6, 3))
+    fig = Figure(figsize=(6.0, 3.0))
     fig.text(
         0.5,
         0.55,
@@ -63,7 +63,8 @@ def _no_equilibrium(params: Params) -> Figure:
         va="center",
         fontsize=13,
     )
-    fig.text(0.5, 0.15, describe(params), ha="center", fontsize=8)
+    caption = fit_text(describe(params), fig.get_figwidth(), 8)
+    fig.text(0.5, 0.15, caption, ha="center", va="top", fontsize=8)
     return fig
 
 
@@ -95,7 +96,8 @@ def _panel(ax, row, p: dict, view: tuple[np.ndarray, float]) -> None:
     _draw_mechanism(ax, sid, p, _BOLD if stable else _THIN, 0.044 * half, 2 * half)
     kind = row.kind or "?"
     label = f"{kind}, stable" if stable else kind
-    ax.set_title(
+    set_title(
+        ax,
         f"#{sid}: $\\gamma_1$ = {row.gamma1_deg:.2f}°, $\\gamma_2$ = {row.gamma2_deg:.2f}°"
         f"\n{label}",
         fontsize=9,
@@ -171,7 +173,7 @@ def configurations_figure(params: Params, solutions: pd.DataFrame) -> Figure:
         ax.set_ylabel("y (m)", fontsize=8)
     _legend(fig, ncols)
     n_stable = int(phys["stable"].astype(bool).sum())
-    fig.suptitle(f"{n} physical equilibria ({n_stable} stable)\n{describe(params)}", fontsize=10)
+    set_title(fig, f"{n} physical equilibria ({n_stable} stable)\n{describe(params)}", fontsize=10)
     return fig
 
 

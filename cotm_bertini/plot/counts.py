@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from .common import flag, param_label, save
+from .common import flag, param_label, save, set_title
 
 
 def sweep_counts(sweep: pd.DataFrame, params: list[str] | tuple[str, ...]) -> pd.DataFrame:
@@ -96,7 +96,8 @@ def sweep_counts_figure(
         note = f"physical: {np.nanmin(P):.0f}-{np.nanmax(P):.0f}"
     ax.set_xlabel(param_label(px))
     ax.set_ylabel(param_label(py))
-    ax.set_title(
+    set_title(
+        ax,
         f"Number of stable equilibria over {px} x {py}, {int(np.isfinite(S).sum())} points "
         f"({note})",
         fontsize=10,

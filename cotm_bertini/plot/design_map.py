@@ -15,7 +15,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from ..params import CASES, Params
-from .common import describe, param_label, save
+from .common import describe, param_label, save, set_title, values_line
 
 FREE_LENGTHS = ("L01", "L02")
 
@@ -55,10 +55,10 @@ def map_figure(
         title = "Stable equilibria over the free lengths, with the fold curves\n"
         title += ", ".join(geometry)
     else:
-        others = [f"{n} = {v:g}" for n, v in params.as_dict().items() if n not in axes]
+        others = values_line(params.as_dict(), leave_out=axes)
         title = f"{params.name}: stable equilibria over ({xname}, {yname}), with the fold curves"
-        title += "\n" + ", ".join(others) if others else ""
-    ax.set_title(title, fontsize=10)
+        title += f"\n{others}" if others else ""
+    set_title(ax, title, fontsize=10)
     ax.legend(handles=handles, loc="upper right", fontsize=8)
     return fig
 

@@ -10,7 +10,7 @@ from matplotlib.figure import Figure
 
 from ..model.compiled import energy
 from ..params import Params
-from .common import describe, physical_rows, save
+from .common import describe, physical_rows, save, set_title
 
 KIND_STYLE = {  # marker, face colour, size, label
     "min": ("o", "limegreen", 70, "min of V"),
@@ -116,7 +116,8 @@ def energy_map_figure(params: Params, solutions: pd.DataFrame, n: int = 300) -> 
     ax.set_aspect("equal")
     ax.set_xlabel("gamma1 (deg)")
     ax.set_ylabel("gamma2 (deg)")
-    ax.set_title(
+    set_title(
+        ax,
         "Potential energy V(gamma1, gamma2) on the torus "
         "(contour levels equally spaced in sqrt(V - min V))\n" + describe(params),
         fontsize=10,
@@ -144,9 +145,10 @@ def barrier_figure(params: Params, solutions: pd.DataFrame, paths: dict, n: int 
             xy = np.insert(wrapped, np.flatnonzero(jumps) + 1, np.nan, axis=0)
             ax.plot(*xy.T, color=PATH_COLOUR, lw=1.4, gid=f"descent-{saddle}", label=label)
             label = "_nolegend_"  # one legend entry for all the paths
-    ax.set_title(
-        f"Descent paths ({PATH_COLOUR} lines) from each saddle ({marker_words('saddle')}) down "
-        f"V(gamma1, gamma2) to the minima ({marker_words('min')})\n" + describe(params),
+    set_title(
+        ax,
+        f"Descent paths ({PATH_COLOUR} lines) from each saddle ({marker_words('saddle')}) to "
+        f"the minima ({marker_words('min')}), down V\n" + describe(params),
         fontsize=10,
     )
     for legend in list(fig.legends):  # redrawn with the paths in it

@@ -10,7 +10,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from ..model.framework.spec import Framework, owner
-from .common import physical_rows, save
+from .common import physical_rows, save, set_title, values_line
 
 _AXES = "xyz"
 _STYLE = {
@@ -58,7 +58,8 @@ def plot_framework(fw: Framework, solutions: pd.DataFrame, path: str | Path) -> 
     n = max(len(rows), 1)
     cols = min(4, n)
     nrows = math.ceil(n / cols)
-    fig = Figure(figsize=(3.2 * cols, 3.0 * nrows + 0.6))
+    # At least two panels wide: room for the title over a single pose.
+    fig = Figure(figsize=(3.2 * max(cols, 2), 3.0 * nrows + 0.6))
     kw = {"projection": "3d"} if fw.dim == 3 else {}
     for k, (_, row) in enumerate(rows.iterrows()):
         ax = fig.add_subplot(nrows, cols, k + 1, **kw)
@@ -66,13 +67,15 @@ def plot_framework(fw: Framework, solutions: pd.DataFrame, path: str | Path) -> 
         if fw.dim == 2:
             ax.set_aspect("equal", adjustable="datalim")
         mark = "stable" if bool(row["stable"]) else str(row["kind"])
-        ax.set_title(f"#{int(row['solution_id'])}: {mark}, V = {row['energy']:.4g}", fontsize=9)
+        set_title(ax, f"#{int(row['solution_id'])}: {mark}, V = {row['energy']:.4g}", fontsize=9)
         ax.tick_params(labelsize=7)
     if not len(rows):
         fig.add_subplot(1, 1, 1).text(0.5, 0.5, "no physical equilibrium", ha="center")
-    fig.suptitle(
+    values = values_line(fw.values)
+    set_title(
+        fig,
         f"{fw.name}: every physical equilibrium (orange: bodies, blue: springs, green dashed: "
-        "taut cables, grey dotted: slack, black: bars)",
+        "taut cables, grey dotted: slack, black: bars)" + (f"\n{values}" if values else ""),
         fontsize=9,
     )
     fig.tight_layout()

@@ -10,7 +10,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from ..model.framework.spec import Framework
-from .common import flag, save
+from .common import flag, save, set_title, values_line
 
 
 def _quantities(fw: Framework, table: pd.DataFrame) -> list[str]:
@@ -44,8 +44,8 @@ def plot_framework_sweep(
         ax.grid(alpha=0.3)
     axes[-1].set_xlabel(param)
     axes[0].legend(loc="best", fontsize=8)
-    fixed = ", ".join(f"{n} = {v:g}" for n, v in fw.values.items() if n != param)
-    fig.suptitle(f"{fw.name}: physical equilibria against {param}" + (f" ({fixed})" if fixed
-                                                                       else ""))  # fmt: skip
+    fixed = values_line(fw.values, leave_out=[param])
+    set_title(fig, f"{fw.name}: physical equilibria against {param}" + (f"\n{fixed}" if fixed
+                                                                        else ""))  # fmt: skip
     fig.tight_layout()
     return save(fig, path)

@@ -25,6 +25,8 @@ _EXPORTS = {
     "sweep": "cotm_bertini.api.sweeps",
     "resume_sweep": "cotm_bertini.api.sweeps",
     "certify": "cotm_bertini.api.certificates",
+    "cost": "cotm_bertini.api.costs",
+    "Cost": "cotm_bertini.api.costs",
     "barriers": "cotm_bertini.api.barriers",
     "Barriers": "cotm_bertini.api.barriers",
     "design": "cotm_bertini.analysis.design.free_lengths",

@@ -53,6 +53,10 @@ LENGTHS = ("L3", "p2x", "p3x", "p3y", "p6x", "p5x", "p5y", "L01", "L02")
 
 # Two points of one body closer than this (relative to L3) are "coincident".
 _COINCIDENT_REL = 1e-9
+# The solvers work in units where the numbers are of order one (normalized(); a framework's
+# units); a number more than this many times its unit leaves too few digits of double
+# precision for the others, and the equations say nothing (Bertini then fails or finds nothing).
+SCALE_LIMIT = 1e12
 
 
 def check_names(given: dict[str, object], known: tuple[str, ...], what: str) -> None:
@@ -161,7 +165,25 @@ def validate(p: Params) -> None:
     for name in ("L01", "L02"):
         if getattr(p, name) < 0:
             raise ParameterError(f"{name} = {getattr(p, name)!r}: a free length must be >= 0")
+    _check_scale(p)
     _check_distinct_points(p, _COINCIDENT_REL * p.L3)
+
+
+def _check_scale(p: Params) -> None:
+    """Every length within SCALE_LIMIT times L3, the spring constants within SCALE_LIMIT of
+    each other (the units the target is solved in: normalized())."""
+    for name in LENGTHS[1:]:
+        if abs(getattr(p, name)) > SCALE_LIMIT * p.L3:
+            raise ParameterError(
+                f"{name} = {getattr(p, name)!r}: over {SCALE_LIMIT:g} times the rod length "
+                f"L3 = {p.L3!r}; double precision cannot solve that"
+            )
+    small, large = sorted(("k1", "k2"), key=lambda n: getattr(p, n))
+    if getattr(p, large) > SCALE_LIMIT * getattr(p, small):
+        raise ParameterError(
+            f"{large} = {getattr(p, large)!r}: over {SCALE_LIMIT:g} times {small} = "
+            f"{getattr(p, small)!r}; double precision cannot solve that"
+        )
 
 
 def _check_distinct_points(p: Params, tol: float) -> None:

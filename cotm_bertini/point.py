@@ -101,13 +101,13 @@ def _checks(morse: dict, counts: dict) -> tuple[str, tuple[str, ...]]:
     """The status and the warnings of a solve: complete, or why equilibria may be missing."""
     warnings = []
     if not morse["ok"]:
-        text = (
-            f"#min - #saddle + #max (+ zero-length maxima) = {morse['euler_characteristic']}"
-            " != 0 on the torus"
+        total = morse["euler_characteristic"]
+        parts = [f"#min - #saddle + #max (+ zero-length maxima) = {total} != 0 on the torus"] * (
+            total != 0
         )
-        if morse["degenerate"]:
-            text += f", {morse['degenerate']} degenerate"
-        warnings.append(text + ": equilibria may be missing")
+        parts += [f"{morse['degenerate']} degenerate"] * bool(morse["degenerate"])
+        parts += ["no minimum, though V has one on the compact torus"] * (not morse["min"])
+        warnings.append("; ".join(parts) + ": equilibria may be missing")
     if counts.get("lost_paths"):
         warnings.append(f"{counts['lost_paths']} paths lost: solutions may be missing")
     return (STATUS_INCOMPLETE if warnings else STATUS_OK), tuple(warnings)

@@ -13,6 +13,7 @@ import os
 from dataclasses import asdict, dataclass, field, fields, replace
 
 from .errors import ParameterError
+from .literals import bertini_number
 
 # Bertini CONFIG keys we render, and their names in the input file.
 CONFIG_KEYS = {
@@ -121,7 +122,7 @@ class Settings:
         for attr, key in CONFIG_KEYS.items():
             value = getattr(self, attr)
             if value is not None and attr != "mptype":
-                cfg[key] = repr(value) if isinstance(value, float) else str(value)
+                cfg[key] = bertini_number(value) if isinstance(value, float) else str(value)
         cfg.update(self.extra_config)
         return cfg
 

@@ -10,7 +10,7 @@ PACKAGE = Path(__file__).resolve().parent.parent / "cotm_bertini"
 # Lower layers never import higher ones (data flows params -> model -> backends -> analysis ->
 # point -> continuation -> io/plot -> api -> paper -> cli).
 LAYERS = [
-    {"_version", "errors", "fs", "versions", "resources", "columns"},
+    {"_version", "errors", "fs", "versions", "resources", "columns", "literals", "progress"},
     {"params", "settings"},
     {"model"},
     {"backends"},

@@ -28,7 +28,7 @@ def test_rendered_input_round_trips():
         params = make_params(case, {"k2": 2.7, "p5y": -3.1e-4})
         system = polynomial_system(params)
         text = render_input(system, Settings(seed=5, final_tol=1e-12), params.as_dict(), case)
-        assert "RandomSeed: 5;" in text and "MPType: 2;" in text and "FinalTol: 1e-12;" in text
+        assert "RandomSeed: 5;" in text and "MPType: 2;" in text and "FinalTol: 1.0e-12;" in text
         assert f"variable_group {', '.join(system.variables)};" in text
         funcs = _functions(text)
         assert list(funcs) == list(system.names)

@@ -104,12 +104,13 @@ def completeness(fw: Framework, table: dict, report: dict) -> dict:
             )
     morse = morse_count(fw, table)
     if morse["applicable"] and not morse["ok"]:
-        warnings.append(
-            f"Morse count {morse['euler_characteristic']} != {morse['expected']}, the Euler "
-            f"characteristic of {morse['manifold']}"
-            + (f" ({morse['degenerate']} degenerate)" if morse["degenerate"] else "")
-            + ": equilibria may be missing"
+        total, chi, space = morse["euler_characteristic"], morse["expected"], morse["manifold"]
+        parts = [f"Morse count {total} != {chi}, the Euler characteristic of {space}"] * (
+            total != chi
         )
+        parts += [f"{morse['degenerate']} degenerate"] * bool(morse["degenerate"])
+        parts += [f"no minimum, though V has one on the compact {space}"] * (not morse["min"])
+        warnings.append("; ".join(parts) + ": equilibria may be missing")
     return {"morse": morse, "warnings": warnings}
 
 
@@ -161,7 +162,10 @@ def morse_count(fw: Framework, table: dict) -> dict:
     maxima = sum(c["is_max"] for c in cone_points(fw)) if torus2 else 0
     total = int(sum((-1) ** int(i) for i, k in zip(index, kinds, strict=True) if k != "degenerate"))
     total += maxima * (-1) ** len(factors)
-    ok = total == chi and counts["degenerate"] == 0
+    # V is continuous on the compact configuration space: its global minimum is an equilibrium
+    # (a cone point is a maximum), so a table without a minimum misses equilibria, whatever the
+    # alternating sum says (an empty table sums to the torus' 0).
+    ok = total == chi and counts["degenerate"] == 0 and counts["min"] > 0
     return {"applicable": True, "manifold": " x ".join(factors), "expected": chi, **counts,
             "zero_length_maxima": maxima, "euler_characteristic": total, "ok": ok}  # fmt: skip
 

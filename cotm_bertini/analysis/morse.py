@@ -68,5 +68,7 @@ def morse_check(params: Params, table) -> dict:
     counts = {k: int((kinds == k).sum()) for k in ("min", "saddle", "max", "degenerate")}
     cusps = sum(c["is_max"] for c in zero_length_configurations(params))
     total = counts["min"] - counts["saddle"] + counts["max"] + cusps
-    ok = total == 0 and counts["degenerate"] == 0
+    # V is continuous on the compact torus: its global minimum is an equilibrium (never a cone
+    # point, which is a maximum), so a table without one misses equilibria whatever the total.
+    ok = total == 0 and counts["degenerate"] == 0 and counts["min"] > 0
     return {**counts, "zero_length_maxima": cusps, "euler_characteristic": total, "ok": ok}

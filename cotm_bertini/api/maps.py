@@ -17,6 +17,7 @@ from ..columns import reference
 from ..errors import ParameterError
 from ..fs import atomic_write_text, link_tree, new_folder, write_csv, write_json
 from ..params import Params
+from ..progress import duration, say
 from ..settings import Settings
 
 FREE_LENGTHS = ("L01", "L02")
@@ -161,11 +162,14 @@ def design_map(
 
     (x, xr), (y, yr), points = _axes(model, axes, l01, l02, points)
     t0 = time.perf_counter()
+    say(f"map: fold curves in the window {x} {xr[0]:g}..{xr[1]:g}, {y} {yr[0]:g}..{yr[1]:g}")
     folds, fold_record = _fold_curves(model, x, xr, y, yr, settings, workers)
     t_folds = time.perf_counter() - t0
     inside = folds.physical.astype(bool) & folds[x].between(*xr) & folds[y].between(*yr)
     folds = folds[inside].reset_index(drop=True)
     xs, ys = grid_values(*xr, points), grid_values(*yr, points)
+    say(f"map: {len(folds)} fold points in {duration(t_folds)}; now the stable counts on a "
+        f"{points} x {points} grid (a 2-D sweep)")  # fmt: skip
     sw = sweep(model, x, xs, settings, param2=y, values2=ys, workers=workers, progress=progress)
     regions = _counts(sw.columns, xs, ys, (x, y))
     t_regions = time.perf_counter() - t0 - t_folds

@@ -226,6 +226,9 @@ def _solve_in(work: Path, params: Params, settings: Settings, tol: dict, label: 
     start = time.perf_counter()
     try:
         if not isinstance(params, Params):
+            from .costs import announce
+
+            announce(params, settings)  # the total work first, when there is some to do
             return solve_framework_point(params, settings, Tolerances(**tol))
         return solve_point(params, settings, Tolerances(**tol), folder=work, title=label)
     except (CotmError, KeyboardInterrupt) as exc:

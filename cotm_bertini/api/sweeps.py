@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
@@ -181,26 +180,17 @@ def resume_sweep(
 
 
 def _progress(progress, total: int, pending: int):
-    """A tqdm bar on a terminal, a line every 10 % otherwise; or the caller's callback."""
+    """The sweep's report (progress.Progress: a tqdm bar on a terminal, a line every few
+    seconds otherwise, with the measured rate and the time left); or the caller's callback."""
     if callable(progress):
         return None, progress
     if not progress:
         return None, None
-    done0 = total - pending
-    if sys.stderr.isatty():
-        from tqdm import tqdm
+    from ..progress import Progress
 
-        bar = tqdm(total=total, initial=done0, unit="pt", desc="sweep", file=sys.stderr)
+    report = Progress("sweep", total, "points", delay=0.0, initial=total - pending, force=True)
 
-        def update(done: int, _todo: int, lost: int) -> None:
-            bar.update(1)
-            bar.set_postfix(lost_paths=lost)
+    def update(_done: int, _todo: int, lost: int) -> None:
+        report.update(1, note=f"{lost} paths lost")
 
-        return bar, update
-    step = max(1, pending // 10)
-
-    def lines(done: int, todo: int, lost: int) -> None:
-        if done % step == 0 or done == todo:
-            print(f"sweep: {done0 + done}/{total} points, {lost} paths lost", file=sys.stderr)
-
-    return None, lines
+    return report, update

@@ -14,9 +14,9 @@ from __future__ import annotations
 
 import hashlib
 import json
-import sys
 import time
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager, nullcontext
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -27,14 +27,14 @@ from ..fs import atomic_write_text, cache_root
 from ..model.artefacts import zero_length_points
 from ..model.polynomial import ParametricSystem
 from ..params import Params
+from ..progress import duration, say
 from ..settings import Settings
 from ..versions import bertini2_version
 from .endpoints import Endpoints
+from .path_progress import expected, generic_report, remember, watched
 from .render import render_parameter_homotopy, render_system
 from .start_system import (
-    bezout_number,
     gamma_homotopy_text,
-    group_degrees,
     linear_product_start,
 )
 
@@ -43,13 +43,26 @@ DOUBLE_FINAL_TOLERANCE = 1e-8
 DOUBLE_MAX_STEPS = 2000
 GENERIC_MAX_STEPS = 20000  # steps a path of a framework's generic solve may take
 SECOND_START = 7919  # seed offset of the independent second generic set
-SECONDS_PER_PATH = 0.06  # an ab-initio path of the generic solve (case 3: 192 paths, ~12 s)
 ANNOUNCE_SECONDS = 2.0  # a generic solve expected to take longer is announced on stderr
 CHUNKS_PER_WORKER = 4  # a split generic solve sends this many chunks of paths per Dask worker
+BERTINI_MAX_NORM = 1e5  # Bertini's default security max norm (a larger norm counts as infinite)
 INFINITE_CODES = ("GoingToInfinity", "SecurityMaxNormReached")
 NEVER_TRACKED = ("NeverStarted", "SingularStartPoint")  # lost, whatever the point's norm
 # Every generic set cached before the route was recorded was solved by Bertini's own start.
 EARLIER_ROUTE = {"method": "bertini start system (ZeroDimSolver), one call"}
+
+
+@contextmanager
+def solver_errors(what: str) -> Iterator[None]:
+    """Bertini's own exceptions (parse errors, a rank-deficient system, ...) as one-line
+    SolverErrors that name what was being solved: never a traceback for the user."""
+    try:
+        yield
+    except SolverError:
+        raise
+    except RuntimeError as exc:
+        reason = " ".join(str(exc).split()) or type(exc).__name__
+        raise SolverError(f"{what}: Bertini stopped: {reason}") from exc
 
 
 def _bertini():
@@ -199,7 +212,9 @@ def _load_or_solve(
         except (ValueError, KeyError):
             path.unlink(missing_ok=True)  # a damaged cache entry is recomputed, not trusted
     _announce(ps, seed, path if use_cache else None, groups, scheduler)
-    gs = _solve_generic(ps, seed, key, centre, groups, scheduler)
+    what = f"the generic solution set (seed {seed}, {len(ps.variables)} unknowns)"
+    with solver_errors(what):
+        gs = _solve_generic(ps, seed, key, centre, groups, scheduler)
     if use_cache:
         atomic_write_text(path, json.dumps(gs.to_json()))
     return gs
@@ -208,42 +223,48 @@ def _load_or_solve(
 def _announce(
     ps: ParametricSystem, seed: int, stored: Path | None, groups=None, scheduler=None
 ) -> None:
-    """One line on stderr before a generic solve long enough to be noticed: what, how long."""
-    system = ps.instantiate([1.0 + 0.1j * k for k in range(len(ps.parameters))])
-    paths = (
-        bezout_number(group_degrees(system, groups), [len(g) for g in groups])
-        if groups
-        else system.total_degree
-    )
-    seconds = paths * SECONDS_PER_PATH
+    """One line on stderr before a generic solve long enough to be noticed: what, and a first
+    guess of how long (the progress lines that follow measure the rate on its paths)."""
+    paths, rate, source = expected(ps, groups)
+    seconds = paths * rate
     if seconds < ANNOUNCE_SECONDS:
         return
     where = f"once: kept in {stored} for every later solve" if stored else "not cached"
     how = f", split over the Dask workers at {scheduler}" if scheduler else ""
-    print(
+    roughly = f"{seconds:.0f} s" if seconds < 90 else duration(seconds)
+    say(
         f"cotm-bertini: solving the generic solution set of these equations for seed {seed} "
-        f"({paths} paths, roughly {seconds:.0f} s{how}; {where})",
-        file=sys.stderr,
-        flush=True,
+        f"({paths} paths, roughly {roughly}{how}; {where}); that is a first guess at "
+        f"{rate:.2g} s a path ({source}): the rate is measured as the paths finish"
     )
+
+
+def generic_start(ps: ParametricSystem, seed: int, centre: dict) -> dict[str, complex]:
+    """The start parameters of `seed`'s generic set: `centre` plus a random complex
+    perturbation of size START_SPREAD in every parameter."""
+    rng = np.random.default_rng(seed)
+    return {
+        name: centre[name] + START_SPREAD * complex(*rng.normal(size=2)) / np.sqrt(2)
+        for name in ps.parameters
+    }
 
 
 def _solve_generic(
     ps: ParametricSystem, seed: int, key: str, centre: dict, groups=None, scheduler=None
 ) -> GenericSet:
-    rng = np.random.default_rng(seed)
-    start = {
-        name: centre[name] + START_SPREAD * complex(*rng.normal(size=2)) / np.sqrt(2)
-        for name in ps.parameters
-    }
+    start = generic_start(ps, seed, centre)
     system = ps.instantiate([start[n] for n in ps.parameters])
+    paths, rate, _ = expected(ps, groups)
     t0 = time.perf_counter()
-    if scheduler is None:
-        ends, route = _bertini_solve(system, seed, groups)
-    else:
-        ends, route = _split_solve(system, seed, groups, scheduler)
+    with generic_report(seed, paths, paths * rate >= ANNOUNCE_SECONDS) as report:
+        if scheduler is None:
+            ends, route = _bertini_solve(system, seed, groups, report)
+        else:
+            ends, route = _split_solve(system, seed, groups, scheduler, report)
     seconds = time.perf_counter() - t0
     codes, finite_flags, singular, pts = ends
+    # The next solve of this system (the second seed) starts from this measured rate.
+    remember(ps, groups, seconds / max(len(codes), 1), f"measured on seed {seed}'s paths")
     finite = [i for i, c in enumerate(codes) if finite_flags[i] and c == _SUCCESS]
     regular = [i for i in finite if not singular[i]]
     return GenericSet(
@@ -260,9 +281,10 @@ def _solve_generic(
     )
 
 
-def _bertini_solve(system, seed: int, groups) -> tuple[tuple, dict]:
+def _bertini_solve(system, seed: int, groups, report=None) -> tuple[tuple, dict]:
     """Every path of Bertini's own start system (multihomogeneous with `groups`, else total
-    degree) in one ZeroDimSolver call: (codes, finite, singular, points), the route record."""
+    degree) in one ZeroDimSolver call: (codes, finite, singular, points), the route record.
+    `report` (a progress.Progress) advances as each path finishes."""
     bertini = _bertini()
     from bertini import nag_algorithm as na
 
@@ -273,7 +295,8 @@ def _bertini_solve(system, seed: int, groups) -> tuple[tuple, dict]:
         # A framework's start system can send a few paths crawling for ever; a path cut short
         # shows up as a count the second generic set (another seed) does not confirm.
         solver.set(max_num_steps=GENERIC_MAX_STEPS)
-    solver.solve(show_progress=True)  # a bar on a terminal after 5 s; silent otherwise
+    with watched(solver, report) if report is not None else nullcontext():
+        solver.solve(show_progress=False)  # our report, not Bertini's own bar
     meta, pts = solver.solution_metadata(), solver.all_solutions()
     points = _end_points(pts, len(system.variables))
     if groups:
@@ -295,9 +318,10 @@ def _bertini_solve(system, seed: int, groups) -> tuple[tuple, dict]:
     return ends, route
 
 
-def _split_solve(system, seed: int, groups, scheduler: str) -> tuple[tuple, dict]:
+def _split_solve(system, seed: int, groups, scheduler: str, report=None) -> tuple[tuple, dict]:
     """Every path of our own linear-product start system (backends.start_system), tracked in
-    chunks on the Dask workers at `scheduler`: (codes, finite, singular, points), the route."""
+    chunks on the Dask workers at `scheduler`: (codes, finite, singular, points), the route.
+    `report` (a progress.Progress) advances as each chunk comes back."""
     from .dask_jobs import run_jobs
 
     lp = linear_product_start(system, groups, seed)
@@ -310,7 +334,11 @@ def _split_solve(system, seed: int, groups, scheduler: str) -> tuple[tuple, dict
         starts.extend(lp.chunks(max(1, -(-total // (CHUNKS_PER_WORKER * n)))))
         return [{"texts": texts, "points": c} for c in starts]
 
-    done = dict(run_jobs(track_chunk, jobs, scheduler))
+    done = {}
+    for k, chunk in run_jobs(track_chunk, jobs, scheduler):
+        done[k] = chunk
+        if report is not None:
+            report.update(len(chunk["codes"]))
     chunks = [done[k] for k in range(len(done))]
     ends = [[x for c in chunks for x in c[f]] for f in ("codes", "finite", "singular")]
     pts = np.vstack([c["points"] for c in chunks])
@@ -470,9 +498,16 @@ class TrackReport:
         return out
 
 
-def _configure(solver, settings: Settings, mptype: str, deadline: float | None) -> None:
-    """Every tracking setting the caller passed (Bertini's defaults for the rest)."""
+def _configure(
+    solver, settings: Settings, mptype: str, deadline: float | None, size: float = 1.0
+) -> None:
+    """Every tracking setting the caller passed (Bertini's defaults for the rest). `size`: the
+    largest parameter value's magnitude: Bertini's max norm grows with it, since the solutions
+    grow with the parameters (Zeeman's wheel pulled from 1e5 units away has a band 1e5 long, at
+    infinity for the default max norm, and a run with no solution at all)."""
     options: dict[str, object] = {}
+    if size > 1.0:
+        options["max_norm"] = BERTINI_MAX_NORM * size
     if settings.threads is not None:
         options["num_threads"] = settings.threads
     if mptype == "double":
@@ -506,14 +541,16 @@ def _track(
     mptype: str,
     settings: Settings,
     deadline: float | None,
+    size: float = 1.0,
 ):
     bertini = _bertini()
     from bertini import nag_algorithm as na
 
-    hom, tgt = (bertini.parse.system(text) for text in texts)
-    solver = na.HomotopySolver(hom, [gs.points[i] for i in idx], tgt, mptype=mptype)
-    _configure(solver, settings, mptype, deadline)
-    solver.solve(show_progress=False)
+    with solver_errors(f"the parameter homotopy from the generic set ({len(idx)} paths)"):
+        hom, tgt = (bertini.parse.system(text) for text in texts)
+        solver = na.HomotopySolver(hom, [gs.points[i] for i in idx], tgt, mptype=mptype)
+        _configure(solver, settings, mptype, deadline, size)
+        solver.solve(show_progress=False)
     if deadline is not None and time.perf_counter() > deadline:
         raise SolverError(f"the in-process solve timed out after {settings.timeout:g} s")
     return solver.solution_metadata(), solver.all_solutions()
@@ -551,7 +588,8 @@ def track(
     )
     n = len(gs.points)
     rep = TrackReport(tracked=n, input_text=texts[0])
-    meta, pts = _track(texts, gs, list(range(n)), "double", settings, deadline)
+    size = max([1.0, *(abs(v) for v in target.values())])
+    meta, pts = _track(texts, gs, list(range(n)), "double", settings, deadline, size)
     results = {i: (meta[i], pts[i]) for i in range(n)}
     redo = [i for i in range(n) if _code(meta[i]) != _SUCCESS or not meta[i].is_finite]
     if _crossing(results, [i for i in range(n) if i not in redo]):
@@ -564,7 +602,7 @@ def track(
         redo = kept
     if redo and settings.mptype == 2:
         rep.retracked_adaptive = len(redo)
-        meta2, pts2 = _track(texts, gs, redo, "adaptive", settings, deadline)
+        meta2, pts2 = _track(texts, gs, redo, "adaptive", settings, deadline, size)
         for k, i in enumerate(redo):
             results[i] = (meta2[k], pts2[k])
     rows = []
@@ -632,29 +670,33 @@ def zero_length_roots(params: Params, variables: tuple[str, ...]) -> Endpoints:
 
 def ab_initio(
     ps: ParametricSystem, params: Params | Mapping[str, float], settings: Settings = Settings()
-) -> tuple[Endpoints, int]:
+) -> tuple[Endpoints, TrackReport]:
     """Total-degree solve at the target itself (in-process): the last resort.
 
     Returns the nonsingular finite endpoints (the closed form reports the d = 0 artefacts) and
-    the number of paths that failed (neither finite nor going to infinity).
-    """
+    its report: paths tracked (the total degree), finite, at infinity, lost (neither)."""
     bertini = _bertini()
     from bertini import nag_algorithm as na
 
+    t0 = time.perf_counter()
     bertini.random.set_random_seed(settings.seed)
     values = parameter_values(ps, params)
     system = ps.instantiate([values[n] for n in ps.parameters])
-    solver = na.ZeroDimSolver(bertini.parse.system(render_system(system)))
-    if settings.threads is not None:
-        solver.set(num_threads=settings.threads)
-    solver.solve(show_progress=False)
-    rows, lost = [], 0
-    ends = zip(solver.solution_metadata(), solver.all_solutions(), strict=True)
+    with solver_errors(f"the total-degree solve at the target ({system.total_degree} paths)"):
+        solver = na.ZeroDimSolver(bertini.parse.system(render_system(system)))
+        _configure(solver, settings, "adaptive", None, max([1.0, *map(abs, values.values())]))
+        solver.solve(show_progress=False)
+        ends = list(zip(solver.solution_metadata(), solver.all_solutions(), strict=True))
+    rows, rep = [], TrackReport(tracked=len(ends), method="ab initio")
     for i, (m, p) in enumerate(ends):
         code = _code(m)
         if m.is_finite and code == _SUCCESS:
             if not is_singular(m):
                 rows.append(endpoint_record(i, m, p))
         elif code not in INFINITE_CODES and (m.is_finite or code in NEVER_TRACKED):
-            lost += 1
-    return Endpoints.from_records(ps.variables, rows), lost
+            rep.lost += 1
+            rep.notes.append(f"path {i}: {code}")
+        else:
+            rep.infinite += 1
+    rep.finite, rep.seconds = len(rows), time.perf_counter() - t0
+    return Endpoints.from_records(ps.variables, rows), rep

@@ -31,6 +31,7 @@ from .homotopy import (
     _crossing,
     endpoint_record,
     is_singular,
+    solver_errors,
 )
 from .render import parametric_texts, render_parameter_homotopy, render_system
 
@@ -137,12 +138,13 @@ def _run_homotopy(sub, text: str, points, target: dict, settings: Settings, dead
     from bertini import nag_algorithm as na
 
     system = sub.instantiate([target[n] for n in sub.parameters])
-    hom = bertini.parse.system(text)
-    tgt = bertini.parse.system(render_system(system))
-    solver = na.HomotopySolver(hom, list(points), tgt, mptype="double")
-    _configure(solver, settings, "double", deadline)
-    solver.set(**{k: bertini.multiprec.real_mp(v) for k, v in _CONTINUATION_STEPS.items()})
-    solver.solve(show_progress=False)
+    with solver_errors(f"the continuation from the neighbouring point ({len(points)} paths)"):
+        hom = bertini.parse.system(text)
+        tgt = bertini.parse.system(render_system(system))
+        solver = na.HomotopySolver(hom, list(points), tgt, mptype="double")
+        _configure(solver, settings, "double", deadline, max([1.0, *map(abs, target.values())]))
+        solver.set(**{k: bertini.multiprec.real_mp(v) for k, v in _CONTINUATION_STEPS.items()})
+        solver.solve(show_progress=False)
     if deadline is not None and time.perf_counter() > deadline:
         raise SolverError(f"the in-process solve timed out after {settings.timeout:g} s")
     return solver.solution_metadata(), solver.all_solutions()

@@ -8,6 +8,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..fs import cache_root
+from ..literals import bertini_number
 from ..model.polynomial import ParametricSystem, PolySystem
 from ..resources import template_texts
 from ..settings import Settings
@@ -28,11 +29,6 @@ def _environment():
         lstrip_blocks=True,
         keep_trailing_newline=True,
     )
-
-
-def bertini_number(c: float) -> str:
-    """A real literal that round-trips: repr (Bertini reads its e-notation)."""
-    return repr(float(c))
 
 
 def phc_number(c: float) -> str:

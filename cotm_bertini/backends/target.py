@@ -116,8 +116,7 @@ def from_generic(
             endpoints, rep = endpoints2, rep2
             method = "parameter homotopy from a second start (the first lost paths)"
         else:
-            endpoints, lost = ab_initio(ps, unit, settings)
-            rep.finite, rep.lost = len(endpoints), lost
+            endpoints, rep = ab_initio(ps, unit, settings)
             method = "ab initio (both parameter homotopies lost paths)"
     return endpoints, {**rep.as_dict(), "method": method}, rep.input_text
 

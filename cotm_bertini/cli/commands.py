@@ -11,6 +11,7 @@ from pathlib import Path
 
 from ..errors import ParameterError, SolverError
 from ..fs import link_latest, new_run_folder, output_root
+from ..progress import silenced
 from .options import (
     EXIT_CERTIFICATE,
     EXIT_DISAGREE,
@@ -160,18 +161,20 @@ def sweep(args: argparse.Namespace) -> int:
     if args.resume and not (Path(args.resume) / SPEC_FILE).is_file():
         raise ParameterError(f"--resume {args.resume!r}: not a sweep folder (no {SPEC_FILE})")
     if args.resume:
-        sw = resume_sweep(args.resume, workers, args.scheduler, progress, sys.argv[:])
+        with silenced(args.quiet):  # --quiet: no progress report from any stage
+            sw = resume_sweep(args.resume, workers, args.scheduler, progress, sys.argv[:])
     else:
         base = params_from(args)
         known = None if isinstance(base, Params) else tuple(base.values)
         values = _sweep_spec_values(args, "param", known)
         values2 = _sweep_spec_values(args, "param2", known)
-        sw = sweep_params(
-            base, args.param, values, settings_from(args), param2=args.param2,
-            values2=values2, workers=workers, scheduler=args.scheduler,
-            out=output_root(args.out), progress=progress, command=sys.argv[:],
-            certify=args.certify,
-        )  # fmt: skip
+        with silenced(args.quiet):
+            sw = sweep_params(
+                base, args.param, values, settings_from(args), param2=args.param2,
+                values2=values2, workers=workers, scheduler=args.scheduler,
+                out=output_root(args.out), progress=progress, command=sys.argv[:],
+                certify=args.certify,
+            )  # fmt: skip
     figures = [] if args.no_plots else sw.plot(show_all=args.all)
     rec, stats = sw.record, sw.record["stats"]
     print(
@@ -256,13 +259,18 @@ def paper(args: argparse.Namespace) -> int:
 
 
 def params(args: argparse.Namespace) -> int:
-    """`params`: the parameter set a command line describes (Table 1 by default), as TOML."""
+    """`params`: the parameter set a command line describes (Table 1 by default), as TOML; for
+    a framework also what its first solve will cost (api.costs), as TOML comments."""
     from ..params import PARAM_MEANING, PARAM_UNITS, Params
 
     p = params_from(args)  # exactly the set `solve` would solve
     if not isinstance(p, Params):
+        from ..api.costs import cost
+
         for name, value in p.as_dict().items():
             print(f"{name} = {value!r}")
+        for line in cost(p).lines():  # TOML comments: the output is still a parameter file
+            print(line)
         return EXIT_OK
     for name, value in p.as_dict().items():
         print(f"{name} = {value!r}  # {PARAM_UNITS[name]}, {PARAM_MEANING[name]}")
@@ -346,10 +354,11 @@ def design_map(args: argparse.Namespace) -> int:
     if args.points < 2:
         raise ParameterError(f"--points {args.points}: a map needs at least 2 points a side")
     root = output_root(args.out)
-    found = make_map(
-        model, x, xr, y, yr, points=args.points, settings=settings_from(args),
-        workers=workers, progress=not args.quiet,
-    )  # fmt: skip
+    with silenced(args.quiet):  # --quiet: no progress report from any stage
+        found = make_map(
+            model, x, xr, y, yr, points=args.points, settings=settings_from(args),
+            workers=workers, progress=not args.quiet,
+        )  # fmt: skip
     folder = found.save(new_run_folder(root), plots=not args.no_plots)
     link_latest(root, folder)
     counts = found.regions.stable.value_counts().sort_index()

@@ -23,6 +23,7 @@ from ..model.framework.folds import CurveSystem
 from ..model.framework.spec import Framework
 from ..model.framework.units import normalized_slots
 from ..model.polynomial import PolySystem
+from ..progress import Progress
 from ..settings import Settings, Tolerances
 from .curve_trace import Traced, Window, newton, remembered, trace, turning_point
 from .runner import Run
@@ -34,21 +35,37 @@ FLAT = 1e-6  # a branch's step moving t by less than this does not turn it back 
 SAME = 1e-6  # a crossing's equilibrium is on a branch when Newton from it lands this near
 
 
+def run_reported(run: Run, fn, tasks: list, stage: str, unit: str, batch: int = 1) -> list:
+    """run(fn, tasks) in batches of `batch` tasks (a worker pool's size or twice it), saying
+    how far it has got after each (progress.Progress: silent if it is all quick)."""
+    out: list = []
+    with Progress(stage, len(tasks), unit) as report:
+        for i in range(0, len(tasks), max(1, batch)):
+            part = tasks[i : i + max(1, batch)]
+            out += run(fn, part)
+            report.update(len(part))
+    return out
+
+
 def sweep_seeds(
-    fw: Framework, cs: CurveSystem, specs: list, names, settings: Settings, run: Run
-) -> tuple[list[np.ndarray], list[dict]]:
+    fw: Framework, cs: CurveSystem, specs: list, names, settings: Settings, run: Run,
+    what: str = "fold seeds", batch: int = 1,
+) -> tuple[list[np.ndarray], list[dict]]:  # fmt: skip
     """The fold points on each line (x0, y0, dx, dy) of `specs` (a grid: see the module
     docstring), as points (X, mx, my), and a record of each line. `names`: the map parameters;
     `run`: runs the tasks (runner.worker_pool): the crossings' solves by vertical line, then
-    the lines."""
+    the lines, in batches of `batch` with progress lines headed `what`."""
     ts = np.linspace(0.0, 1.0, _samples(specs))
     vertical = [s for s in specs if s[2] == 0.0]  # every crossing lies on one of them
     run(_generic_sets, [(fw, cs, settings)])  # once, on disk, before the workers need them
     solved: dict = {}
-    for part in run(_solve_line, [(fw, cs, spec, ts, names, settings) for spec in vertical]):
+    tasks = [(fw, cs, spec, ts, names, settings) for spec in vertical]
+    stage = f"{what}: equilibria at {len(vertical)} x {len(ts)} crossings, by vertical line"
+    for part in run_reported(run, _solve_line, tasks, stage, "lines", batch):
         solved.update(part)
     tasks = [(cs, spec, ts, [solved[_key(spec, t)] for t in ts]) for spec in specs]
-    results = run(_line_folds, tasks)
+    stage = f"{what}: branches and their turns along the seed lines"
+    results = run_reported(run, _line_folds, tasks, stage, "lines", batch)
     seeds, lines = [], []
     for found, record in results:
         seeds += found

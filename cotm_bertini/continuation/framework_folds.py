@@ -54,9 +54,10 @@ from ..model.framework.folds import (
 )
 from ..model.framework.spec import Framework
 from ..model.framework.units import normalized_slots, units
+from ..progress import Progress, say
 from ..settings import Settings, Tolerances
 from .curve_trace import Traced, Window, trace, turning_point
-from .fold_sweep import curve_equations, is_real, long_enough, sweep_seeds
+from .fold_sweep import curve_equations, is_real, long_enough, run_reported, sweep_seeds
 from .runner import Run, worker_pool
 
 SEED_ROUTES = ("auto", "witness", "sweep")
@@ -109,26 +110,26 @@ def framework_fold_curves(
     centre = fw.replace(**{xname: sum(xrange) / 2, yname: sum(yrange) / 2})
     frames, record = [], {"taut_sets": {}}
     next_id = 0
+    todo = _curve_systems(fw, centre, (xname, xrange, yname, yrange), kinds)
     with worker_pool(workers) as run:
-        for taut in _window_taut_sets(fw, xname, xrange, yname, yrange):
-            if framework_system(centre, taut).free:
-                continue  # moves freely: no isolated equilibria, so no folds (continuum_check's)
-            for cable in _curve_kinds(centre, taut, kinds):
-                cs = curve_system(centre, taut, xname, yname, cable)
-                name = {"": "fold", RELAXED: "relaxed fold"}.get(cable, f"switch {cable}")
-                group = record["taut_sets"].setdefault(" ".join(taut) or "none", {})
-                if not cs.ps.parameters:
-                    # Neither map parameter enters: its equilibria are the same all over the
-                    # window, so a fold would fill the plane (never, generically) or be absent,
-                    # and its witness system has a free line parameter (no isolated points).
-                    group[name] = {"curves_traced": 0, "points": 0, "why": "its equations "
-                                   f"involve neither {xname} nor {yname}"}  # fmt: skip
-                    continue
-                axes = (xname, xrange), (yname, yrange)
-                curves, info = _find(fw, cs, axes, settings, seeds, run)
-                frame, next_id, about = _rows(fw, curves, (xname, yname), next_id, run)
-                frames.append(frame)
-                group[name] = {**info, **about}
+        for k, (taut, cable) in enumerate(todo):
+            cs = curve_system(centre, taut, xname, yname, cable)
+            name = {"": "fold", RELAXED: "relaxed fold"}.get(cable, f"switch {cable}")
+            group = record["taut_sets"].setdefault(" ".join(taut) or "none", {})
+            if not cs.ps.parameters:
+                # Neither map parameter enters: its equilibria are the same all over the
+                # window, so a fold would fill the plane (never, generically) or be absent,
+                # and its witness system has a free line parameter (no isolated points).
+                group[name] = {"curves_traced": 0, "points": 0, "why": "its equations "
+                               f"involve neither {xname} nor {yname}"}  # fmt: skip
+                continue
+            axes = (xname, xrange), (yname, yrange)
+            what = f"fold curves {k + 1}/{len(todo)} ({name}, taut set {' '.join(taut) or 'none'})"
+            work = _Work(run, 2 * workers if workers > 1 else 1, what)
+            curves, info = _find(fw, cs, axes, settings, seeds, work)
+            frame, next_id, about = _rows(fw, curves, (xname, yname), next_id, work)
+            frames.append(frame)
+            group[name] = {**info, **about}
     table = pd.concat(frames, ignore_index=True) if frames else _empty(fw, xname, yname)
     record.update(
         window={xname: list(xrange), yname: list(yrange)}, spacing=SPACING, lines=LINES,
@@ -138,6 +139,31 @@ def framework_fold_curves(
         curves_found=int(table.loc[table["curve_id"] >= 0, "curve_id"].nunique()),
     )  # fmt: skip
     return table, record
+
+
+@dataclass(frozen=True)
+class _Work:
+    """How a curve system's tasks run: the worker pool's `run`, in batches of `batch` tasks,
+    their progress lines headed `what`."""
+
+    run: Run
+    batch: int
+    what: str
+
+    def __call__(self, fn, tasks: list, stage: str, unit: str) -> list:
+        return run_reported(self.run, fn, tasks, f"{self.what}: {stage}", unit, self.batch)
+
+
+def _curve_systems(fw: Framework, centre: Framework, window: tuple, kinds) -> list[tuple]:
+    """(taut set, cable) of every curve system to find (curve_system's `cable`), in order: the
+    window's taut sets that do not move freely (those have no isolated equilibria, so no
+    folds: continuum_check's), each with its curve kinds."""
+    return [
+        (taut, cable)
+        for taut in _window_taut_sets(fw, *window)
+        if not framework_system(centre, taut).free
+        for cable in _curve_kinds(centre, taut, kinds)
+    ]
 
 
 def _window_taut_sets(fw: Framework, xname: str, xrange, yname: str, yrange) -> list[tuple]:
@@ -188,10 +214,12 @@ def _centre(cs: CurveSystem, fw: Framework, xname: str, yname: str) -> dict:
     return {n: line[n] for n in cs.ps.parameters}
 
 
-def _line_seeds(cs, gs, win: Window, settings) -> tuple[list, list[dict]]:
+def _line_seeds(cs, gs, win: Window, settings, what: str) -> tuple[list, list[dict]]:
     """Real points of the curve on LINES vertical and LINES horizontal lines of the window."""
     seeds, lines = [], []
-    for x0, y0, dx, dy in _line_specs(win):
+    specs = _line_specs(win)
+    report = Progress(f"{what}: the witness set to the seed lines", len(specs), "lines")
+    for x0, y0, dx, dy in specs:
         target = {LINE[0]: x0, LINE[1]: y0, LINE[2]: dx, LINE[3]: dy}
         # Straight from the witness set, no fallback: on a real line some paths go to infinity
         # (on every line tried, axis-parallel or not), which is expected, not a failure. A seed
@@ -206,10 +234,12 @@ def _line_seeds(cs, gs, win: Window, settings) -> tuple[list, list[dict]]:
                 found += 1
         lines.append({"line": [x0, y0, dx, dy], "finite": rep.finite, "infinite": rep.infinite,
                       "lost": rep.lost, "real_in_window": found})  # fmt: skip
+        report.update(1, note=f"{len(seeds)} seeds")
+    report.close()
     return seeds, lines
 
 
-def _find(fw: Framework, cs: CurveSystem, axes, settings, seeds: str, run: Run) -> tuple:
+def _find(fw: Framework, cs: CurveSystem, axes, settings, seeds: str, work: _Work) -> tuple:
     """Seeds on lines (by the chosen route), and every curve through a seed traced once."""
     (xname, xrange), (yname, yrange) = axes
     t0 = time.perf_counter()
@@ -223,28 +253,24 @@ def _find(fw: Framework, cs: CurveSystem, axes, settings, seeds: str, run: Run) 
     if cs.kind == "relaxed":
         route = "witness"  # module docstring: a sweep cannot tell relaxed folds from others
     info: dict = {"seed_route": route, "witness_paths": paths}
+    how = f"a witness set of {paths} paths" if route == "witness" else "a sweep of the lines"
+    say(f"{work.what}: seeds on {2 * LINES} lines by {how}")
     if route == "witness":
         centre = _centre(cs, fw, xname, yname)
         gs = generic_set(cs.ps, settings.seed, centre=centre, groups=groups)
         info.update(generic_set=gs.summary(), generic_seconds=time.perf_counter() - t0)
         t1 = time.perf_counter()
-        seeds_found, lines = _line_seeds(cs, gs, win, settings)
+        seeds_found, lines = _line_seeds(cs, gs, win, settings, work.what)
     else:
         t1 = time.perf_counter()
         specs = _line_specs(win)
-        seeds_found, lines = sweep_seeds(fw, cs, specs, (xname, yname), settings, run)
+        seeds_found, lines = sweep_seeds(
+            fw, cs, specs, (xname, yname), settings, work.run, work.what, work.batch
+        )
         info.update(sweep_points=lines[0]["points"])
     t2 = time.perf_counter()
     eqs = curve_equations(cs)
-    traced, skipped = [], 0
-    lengths = [k for k, v in enumerate(cs.variables) if v.startswith("d_")]
-    for z in seeds_found:
-        if (z[lengths] <= 0).any():
-            continue  # a length never changes sign on a curve (L0 > 0): never physical
-        if any(_on(c.points, z, win, len(cs.variables)) for c in traced):
-            skipped += 1
-            continue
-        traced.append(trace(eqs, z, win, SPACING, HMAX, long_enough(cs), relative=True))
+    traced, skipped = _trace_seeds(cs, eqs, seeds_found, win, work.what)
     info.update({
         "lines_seconds": t2 - t1, "trace_seconds": time.perf_counter() - t2,
         "seeds": len(seeds_found), "seeds_on_traced": skipped, "lines": lines,
@@ -253,6 +279,24 @@ def _find(fw: Framework, cs: CurveSystem, axes, settings, seeds: str, run: Run) 
         "unrefined_turns": int(sum(ln.get("unrefined", 0) for ln in lines)),
     })  # fmt: skip
     return _Curves(cs, traced, win, eqs), info
+
+
+def _trace_seeds(cs: CurveSystem, eqs, seeds: list, win: Window, what: str) -> tuple[list, int]:
+    """Every curve through a seed traced once (a seed on a curve already traced is skipped):
+    the curves, and how many seeds were skipped."""
+    traced, skipped = [], 0
+    lengths = [k for k, v in enumerate(cs.variables) if v.startswith("d_")]
+    with Progress(f"{what}: tracing curves from seeds", len(seeds), "seeds",
+                  heartbeat=True) as report:  # fmt: skip
+        for z in seeds:
+            report.update(1, note=f"{len(traced)} curves")
+            if (z[lengths] <= 0).any():
+                continue  # a length never changes sign on a curve (L0 > 0): never physical
+            if any(_on(c.points, z, win, len(cs.variables)) for c in traced):
+                skipped += 1
+                continue
+            traced.append(trace(eqs, z, win, SPACING, HMAX, long_enough(cs), relative=True))
+    return traced, skipped
 
 
 def _line_specs(win: Window) -> list[tuple[float, float, float, float]]:
@@ -364,13 +408,15 @@ def _null_cubics(cs: CurveSystem, pts: np.ndarray) -> np.ndarray:
     return np.concatenate(out) if out else np.zeros(0)
 
 
-def _rows(fw: Framework, curves: _Curves, names, next_id: int, run: Run) -> tuple:
+def _rows(fw: Framework, curves: _Curves, names, next_id: int, work: _Work) -> tuple:
     """The table of one curve system's curves (physical points only, a curve split where it
     stops being physical), the next free curve_id, and counts for the record."""
     cs, win = curves.cs, curves.window
     kind = "cable_switch" if cs.kind == "switch" else "fold"  # a relaxed fold is a fold
     parts = [np.array_split(c.points, -(-len(c.points) // CHUNK)) for c in curves.traced]
-    done = iter(run(_classify_points, [(fw, cs, pts, names) for ps in parts for pts in ps]))
+    tasks = [(fw, cs, pts, names) for ps in parts for pts in ps]
+    unit = f"chunks of {CHUNK} points"
+    done = iter(work(_classify_points, tasks, "classifying the points", unit))
     rows, artefacts, cusps = [], 0, 0
     for curve, ps in zip(curves.traced, parts, strict=True):
         classified = [r for _ in ps for r in next(done)]

@@ -22,7 +22,8 @@ from ..params import Params
 from .polynomial import ParametricSystem, PolySystem
 
 _SOURCES = tuple(
-    Path(__file__).resolve().parent / f for f in ("equations.py", "kinematics.py", "symbolic.py")
+    Path(__file__).resolve().parent / f
+    for f in ("equations.py", "kinematics.py", "symbolic.py", "../literals.py")
 )
 
 

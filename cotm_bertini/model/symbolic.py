@@ -5,7 +5,21 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
+from ..literals import bertini_number
 from .polynomial import ParametricSystem
+
+
+class _BertiniPrinter(sp.printing.str.StrPrinter):
+    """sympy's str form with every float written as bertini_number writes it (sstr's
+    "1.0000000000000000e+16" has the "+" Bertini 2's parser refuses)."""
+
+    def _print_Float(self, expr: sp.Float) -> str:
+        return bertini_number(float(expr))
+
+
+def bertini_text(expr: sp.Expr) -> str:
+    """An expression in Bertini's syntax: floats as bertini_number, powers as ^."""
+    return _BertiniPrinter().doprint(expr).replace("**", "^")
 
 
 def parametric_from_sympy(
@@ -30,7 +44,7 @@ def parametric_from_sympy(
         var_exps.append(np.array([m[: len(xs)] for m, _ in terms], dtype=np.int64))
         par_exps.append(np.array([m[len(xs) :] for m, _ in terms], dtype=np.int64))
         coeffs.append(np.array([float(c) for _, c in terms], dtype=float))
-        texts.append(sp.sstr(f).replace("**", "^"))
+        texts.append(bertini_text(f))
     return ParametricSystem(
         tuple(variables), tuple(names), used, tuple(var_exps), tuple(par_exps), tuple(coeffs),
         tuple(texts),

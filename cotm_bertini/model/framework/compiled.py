@@ -41,16 +41,22 @@ class FrameworkSystem:
 _LOADED: dict[str, FrameworkSystem] = {}
 
 
-def framework_system(fw: Framework, taut: tuple[str, ...]) -> FrameworkSystem:
-    """The structure's system, from memory, the disk cache, or derived with sympy."""
+def framework_system(fw: Framework, taut: tuple[str, ...], label: str = "") -> FrameworkSystem:
+    """The structure's system, from memory, the disk cache, or derived with sympy (saying so
+    every few seconds when that takes long; `label` names the taut set, e.g. "taut set 2/4")."""
     key = structure_key(fw, taut)
     if key in _LOADED:
         return _LOADED[key]
 
     def fresh() -> Derived:
+        from ...progress import Progress
         from .derive import derive
 
-        return derive(fw, tuple(sorted(taut)))
+        names = " ".join(taut) or "none"
+        stage = f"deriving the equations of {fw.name}, " + (
+            f"{label} ({names})" if label else f"taut set {names}")  # fmt: skip
+        with Progress(stage, None, "", heartbeat=True) as report:
+            return derive(fw, tuple(sorted(taut)), step=lambda what: report.update(0, note=what))
 
     derived, module = cached_derivation(f"system-{key}", Derived, fresh)
     out = FrameworkSystem(

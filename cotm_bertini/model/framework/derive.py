@@ -144,10 +144,13 @@ def equilibrium_equations(fw: Framework, taut: tuple[str, ...]) -> tuple:
     return config + extra, kinds + extra_kinds, equations, about + law_about
 
 
-def derive(fw: Framework, taut: tuple[str, ...]) -> Derived:
-    """The equilibrium system of `fw` with the cables in `taut` taut and the others slack."""
+def derive(fw: Framework, taut: tuple[str, ...], step=None) -> Derived:
+    """The equilibrium system of `fw` with the cables in `taut` taut and the others slack.
+    `step(what)`, if given, hears which part is being derived (for progress lines)."""
     from ..symbolic import numpy_function, parametric_from_sympy
 
+    step = step or (lambda what: None)
+    step("the equilibrium equations")
     lay = layout(fw)
     const = {sp.Symbol(n): sp.Float(v, 17) for n, v in constants(fw).items()}
     rot_syms = {b: [sp.Symbol(n) for n in rotation_names(fw.dim, b)] for b in lay.rotations}
@@ -162,7 +165,9 @@ def derive(fw: Framework, taut: tuple[str, ...]) -> Derived:
         tuple(variables), tuple(f"f{i + 1}" for i in range(len(equations))),
         tuple(equations), tuple(slots),
     )  # fmt: skip
+    step("the second-order terms")
     local, hess, cjac, firsts = _second_order(fw, lay, rot_syms, taut, config)
+    step("the numeric code")
     # Named points, then each body's frame origin under the body's own name.
     points = sorted(point_names(fw)) + list(lay.rotations)
     coords = [c for p in points[: -len(lay.rotations) or None] for c in pos.of(p)]
@@ -177,6 +182,7 @@ def derive(fw: Framework, taut: tuple[str, ...]) -> Derived:
         numpy_function(name, args, [e.xreplace(const) for e in exprs] or [sp.S(0)])
         for name, exprs in functions.items()
     )
+    step("the zero-length poses")
     cones = _cone_systems(fw, lay, pos, taut, slots, const)
     return Derived(ps.to_json(), kinds, descriptions, free, points, local,
                    len(cjac) // max(local, 1), source, [x.name for x in _active(fw, taut)],

@@ -12,10 +12,11 @@ import hashlib
 import math
 import re
 from dataclasses import dataclass, replace
+from functools import lru_cache
 from pathlib import Path
 
 from ...errors import ParameterError
-from ...params import read_toml
+from ...params import SCALE_LIMIT, read_toml
 from .expressions import Expr, parse
 
 _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
@@ -367,3 +368,53 @@ def check_values(fw: Framework) -> None:
             raise ParameterError(f"{where}.k = {s[f'k_{x.name}']!r}: must be > 0")
         if s[f"L0_{x.name}"] < 0:
             raise ParameterError(f"{where}.L0 = {s[f'L0_{x.name}']!r}: must be >= 0")
+    check_scale(fw)
+
+
+# How each slot scales with the length unit L and the stiffness unit k.
+_SLOT_KINDS = {"g_": "len", "b_": "len", "len_": "len", "L0_": "len", "k_": "k", "f_": "force"}
+
+
+def slot_kind(name: str) -> str:
+    """len, k or force: how a slot scales."""
+    return next(kind for prefix, kind in _SLOT_KINDS.items() if name.startswith(prefix))
+
+
+def scale_of(kind: str, length: float, stiffness: float) -> float:
+    """The unit of a quantity of this kind: rot 1, len L, k k, force k L."""
+    return {"rot": 1.0, "len": length, "k": stiffness, "force": stiffness * length}[kind]
+
+
+@lru_cache(maxsize=256)
+def units(fw: Framework) -> tuple[float, float]:
+    """(length unit, stiffness unit): the largest length and the largest k at the file's values
+    (the framework is solved in these units; units.py)."""
+    slots = fw.at_defaults().slots()
+    lengths = [abs(v) for n, v in slots.items() if slot_kind(n) == "len" and v != 0]
+    ks = [v for n, v in slots.items() if n.startswith("k_")]
+    return (max(lengths) if lengths else 1.0), (max(ks) if ks else 1.0)
+
+
+_UNIT_NAMES = {"len": "length unit", "k": "stiffness unit", "force": "force unit (k L)"}
+
+
+def check_scale(fw: Framework) -> None:
+    """Refuse values the equations cannot hold in double precision: a number over SCALE_LIMIT
+    times the file's own unit of its kind, or a bar length or stiffness under 1/SCALE_LIMIT of
+    it. The message names the parameters behind the number."""
+    length, stiffness = units(fw)
+    exprs = fw.slot_expressions()
+    for name, value in fw.slots().items():
+        unit = scale_of(slot_kind(name), length, stiffness)
+        ratio = abs(value) / unit
+        tiny = name.startswith(("len_", "k_")) and ratio < 1 / SCALE_LIMIT
+        if ratio <= SCALE_LIMIT and not tiny:
+            continue
+        used = sorted(exprs[name].names())
+        who = ", ".join(f"{p} = {fw.values[p]!r}" for p in used) or f"{name} = {value!r}"
+        bound = f"under {1 / SCALE_LIMIT:g}" if tiny else f"over {SCALE_LIMIT:g}"
+        raise ParameterError(
+            f"{who}: makes {name} = {value:.6g}, {bound} times the file's "
+            f"{_UNIT_NAMES[slot_kind(name)]} {unit:.6g}; double precision cannot solve that "
+            "(keep every number within 1e12 of the file's own values)"
+        )

@@ -104,6 +104,7 @@ _SOURCES = tuple(
         "framework/spec.py",
         "framework/units.py",
         "symbolic.py",
+        "../literals.py",
         "polynomial.py",
     )
 )

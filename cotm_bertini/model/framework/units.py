@@ -9,29 +9,10 @@ from __future__ import annotations
 
 from functools import lru_cache
 
-from .spec import Framework
+# Defined next to the framework (its values are checked against them); used from here.
+from .spec import Framework, scale_of, slot_kind, units
 
-# How each slot scales with the length unit L and the stiffness unit k.
-_SLOT_KINDS = {"g_": "len", "b_": "len", "len_": "len", "L0_": "len", "k_": "k", "f_": "force"}
-
-
-def slot_kind(name: str) -> str:
-    """len, k or force: how a slot scales."""
-    return next(kind for prefix, kind in _SLOT_KINDS.items() if name.startswith(prefix))
-
-
-def scale_of(kind: str, length: float, stiffness: float) -> float:
-    """The unit of a quantity of this kind: rot 1, len L, k k, force k L."""
-    return {"rot": 1.0, "len": length, "k": stiffness, "force": stiffness * length}[kind]
-
-
-@lru_cache(maxsize=256)
-def units(fw: Framework) -> tuple[float, float]:
-    """(length unit, stiffness unit): the largest length and the largest k at the file's values."""
-    slots = fw.at_defaults().slots()
-    lengths = [abs(v) for n, v in slots.items() if slot_kind(n) == "len" and v != 0]
-    ks = [v for n, v in slots.items() if n.startswith("k_")]
-    return (max(lengths) if lengths else 1.0), (max(ks) if ks else 1.0)
+__all__ = ["constants", "normalized_slots", "scale_of", "slot_kind", "units"]
 
 
 def normalized_slots(fw: Framework) -> dict[str, float]:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -38,6 +39,17 @@ def test_paper_cases_are_proved(case, n):
     nonsingular = ~table["singular"].to_numpy()
     assert cert.certified[nonsingular].all() and not cert.certified[~nonsingular].any()
     assert not cert.undecided_boxes and not cert.contradictions
+    # The spring-length bound agrees with the statement's claim (issue 27): no free length in
+    # case 1 (no claim, bound 0), none reaching zero length in case 2 (a lower bound, rounded
+    # down), boxes set aside in case 3 (an upper bound, rounded up).
+    said = re.search(r"longer than ([0-9.e+-]+) m", cert.statement)
+    if case == "case1":
+        assert "(no spring has a free length)" in cert.statement and cert.shortest_spring == 0
+    elif case == "case2":
+        assert "in every pose: none reaches zero length" in cert.statement
+        assert 0 < float(said.group(1)) <= cert.shortest_spring and not cert.excluded_boxes
+    else:
+        assert cert.excluded_boxes and 0 < cert.shortest_spring <= float(said.group(1))
 
 
 @pytest.mark.parametrize("seed", RANDOM)

@@ -30,7 +30,15 @@ from ...model.framework.spec import Framework
 from ...model.framework.structure import layout
 from ...model.framework.units import normalized_slots, slot_kind, units
 from .inertia import reduced_kind
-from .mechanism import Certificate, duplicates, kind_differences
+from .mechanism import (
+    ROOT_FAILED,
+    Certificate,
+    duplicates,
+    kind_differences,
+    not_proved_text,
+    spring_bound,
+    spring_clause,
+)
 from .roots import WORKING_BITS, ball_system_of, certify_points
 from .search import Known
 from .torus import Landscape, krawczyk_box, torus_search
@@ -90,6 +98,7 @@ class _Rows:
     physical: dict[int, str] = field(default_factory=dict)  # row -> yes, no, unknown
     kinds: dict[int, str] = field(default_factory=dict)  # solution_id -> proved kind
     as_doubles: list[int] = field(default_factory=list)  # proved with the doubles exact only
+    failed: dict[int, str] = field(default_factory=dict)  # solution_id -> the step that failed
 
 
 def _row_points(fw: Framework, fs: FrameworkSystem, table, rows: np.ndarray) -> tuple:
@@ -161,6 +170,8 @@ def certify_rows(fw: Framework, table, P: list, exact: list) -> _Rows:
                         out.as_doubles.append(int(table["solution_id"][row]))
                     X = [_real_ball(z, r) for z, r in zip(*proof, strict=True)]
                     _judge(fw, fs, table, int(row), X, slots, out)
+        for row in rows[~out.certified[rows]]:
+            out.failed[int(table["solution_id"][row])] = ROOT_FAILED
     return out
 
 
@@ -176,29 +187,38 @@ def _judge(fw, fs, table, row: int, X: list, P: list, out: _Rows) -> None:
     """Consistency and kind of one proved real row over its box X."""
     from flint import ctx
 
+    sid = int(table["solution_id"][row])
     bits, ctx.prec = ctx.prec, WORKING_BITS
     try:
-        out.physical[row] = consistency(fw, fs, X, P)
+        out.physical[row], open_links = consistency(fw, fs, X, P)
+        if out.physical[row] == "unknown":
+            out.failed[sid] = (f"consistency: {', '.join(open_links)} against zero or the free "
+                               "length not decided over the proved box")  # fmt: skip
         if out.physical[row] == "yes":
             code, m = ball_module(fs), fs.local_size
             h = [_ball(v) for v in code.hessian(X, P)]
             g = [_ball(v) for v in code.constraint_jacobian(X, P)] if fs.constraints else []
             H = [h[i * m : (i + 1) * m] for i in range(m)]
             G = [g[i * m : (i + 1) * m] for i in range(len(g) // m)] if g else []
-            out.kinds[int(table["solution_id"][row])] = reduced_kind(H, G)
+            out.kinds[sid] = reduced_kind(H, G)
+            if out.kinds[sid] == "undecided":
+                finite = all(b.is_finite() for line in H + G for b in line)
+                out.failed[sid] = "kind: " + (
+                    "a pivot of the ball LDL^T of the bordered Hessian contains 0" if finite
+                    else "the Hessian's enclosure over the proved box is not finite")  # fmt: skip
     finally:
         ctx.prec = bits
 
 
-def consistency(fw: Framework, fs: FrameworkSystem, X: list, P: list) -> str:
-    """'yes' when the box X proves the row physical (each length variable > 0, each taut cable
-    longer than its free length, each slack one shorter), 'no' when it proves it is not,
-    'unknown' otherwise."""
+def consistency(fw: Framework, fs: FrameworkSystem, X: list, P: list) -> tuple[str, list[str]]:
+    """('yes' when the box X proves the row physical (each length variable > 0, each taut
+    cable longer than its free length, each slack one shorter), 'no' when it proves it is not,
+    'unknown' otherwise; the links whose condition is not decided)."""
     index = {v: j for j, v in enumerate(fs.ps.variables)}
     slot = {n: j for j, n in enumerate(fw.slots())}
     pos = ball_module(fs).positions(X, P)
     where = {p: pos[k * fw.dim : (k + 1) * fw.dim] for k, p in enumerate(fs.points)}
-    verdicts = []
+    verdicts, open_links = [], []
     for x in fw.links:
         if x.kind == "bar" or (x.kind == "spring" and f"d_{x.name}" not in index):
             continue  # a bar, or a spring of zero free length: no condition
@@ -217,7 +237,9 @@ def consistency(fw: Framework, fs: FrameworkSystem, X: list, P: list) -> str:
         below = hi is None or d < hi
         wrong = (lo is not None and d < lo) or (hi is not None and d > hi)
         verdicts.append("yes" if above and below else "no" if wrong else "unknown")
-    return "no" if "no" in verdicts else "unknown" if "unknown" in verdicts else "yes"
+        open_links += [f"{x.kind} {x.name}"] if verdicts[-1] == "unknown" else []
+    verdict = "no" if "no" in verdicts else "unknown" if "unknown" in verdicts else "yes"
+    return verdict, open_links
 
 
 def torus_landscape(fw: Framework, P: list) -> Landscape:
@@ -347,17 +369,25 @@ def certify_framework_table(
     else:
         t_known = t_rows
     t_done = time.perf_counter()
-    status, statement = _verdict(table, rows, proof, scope, contradictions, units(fw)[0])
+    bound, meaning = spring_bound(proof) if proof else (0.0, "none")
+    bound *= units(fw)[0]
+    status, statement = _verdict(table, rows, proof, scope, contradictions,
+                                 spring_clause(bound, meaning))  # fmt: skip
     found = {sid for sid, boxes in proof.roots.items() if boxes} if proof else set()
     timings = {"rows": t_rows - start, "equilibria": t_known - t_rows,
                "completeness": t_done - t_known}  # fmt: skip
     return Certificate(
-        status, statement, rows.certified, rows.radius, len(found), rows.kinds,
-        proof.longest_excluded * units(fw)[0] if proof else 0.0,
+        status, statement, rows.certified, rows.radius,
+        len(found) if proof else len(_proved_equilibria(rows)), rows.kinds, bound,
         proof.boxes if proof else 0, len(proof.excluded) if proof else 0,
         proof.undecided if proof else [], contradictions, time.perf_counter() - start, timings,
-        "framework-rows" if scope else "framework-torus",
+        "framework-rows" if scope else "framework-torus", dict(sorted(rows.failed.items())),
     )  # fmt: skip
+
+
+def _proved_equilibria(rows: _Rows) -> list[int]:
+    """The solution ids proved real, consistent and of a proved kind: equilibria, proved."""
+    return sorted(sid for sid, kind in rows.kinds.items() if kind != "undecided")
 
 
 def _enclosure_balls(bounds: tuple) -> tuple:
@@ -424,18 +454,15 @@ def _search_contradictions(fw, table, proof, known: list[Known], unproved: list[
     return out
 
 
-def _verdict(table, rows: _Rows, proof, scope: str, contradictions: list, length: float):
+def _verdict(table, rows: _Rows, proof, scope: str, contradictions: list, where: str):
     """(status, statement): 'contradiction', 'undecided', 'proved' (rows and completeness) or
-    'rows proved' (every real row proved; completeness not proved: `scope` says why)."""
+    'rows proved' (every real row proved; completeness not proved: `scope` says why); `where`:
+    the spring-length clause of a completeness proof. Rows not proved are named with the step
+    that failed (`_Rows.failed`), and only those proved are counted as proved."""
     real = np.asarray(table["is_real"], dtype=bool)
     singular = np.asarray(table["singular"], dtype=bool)
-    sids = np.asarray(table["solution_id"], dtype=int)
-    open_rows = sids[real & ~singular & ~rows.certified].tolist()
-    unsure = [int(sids[r]) for r, v in rows.physical.items() if v == "unknown"]
-    unsure += [sid for sid, kind in rows.kinds.items() if kind == "undecided"]
-    undecided = bool(open_rows or unsure or (proof is not None and proof.undecided))
-    n_phys = sum(1 for v in rows.physical.values() if v == "yes")
-    tail = (f"{int(rows.certified.sum())} of {len(sids)} solutions certified "
+    n_rows = len(real)
+    tail = (f"{int(rows.certified.sum())} of {n_rows} solutions certified "
             f"({int(singular.sum())} singular double roots cannot be; "
             f"{int((~real & ~singular).sum())} complex rows not tried: the table keeps their "
             "real parts only)")  # fmt: skip
@@ -444,27 +471,28 @@ def _verdict(table, rows: _Rows, proof, scope: str, contradictions: list, length
             f"; solutions {sorted(rows.as_doubles)} proved for the file's numbers as "
             "doubles only (their decimals' half-ulp moves them more than the box allows)"
         )
-    if open_rows or unsure:
-        tail += f"; not proved: solutions {sorted(set(open_rows + unsure))}"
+    failed = not_proved_text(rows.failed)
+    undecided = bool(rows.failed or (proof is not None and proof.undecided))
+    complete = "rows proved" if proof is None else "proved"
+    status = "contradiction" if contradictions else "undecided" if undecided else complete
+    if status == "contradiction":
+        found = f" ({_found(proof)} equilibria proved {where})" if proof else ""
+        also = f"; not proved: {failed}" if failed else ""
+        return status, f"CONTRADICTION: the table and the proof differ{found}; {tail}{also}"
     if proof is None:
-        status = "contradiction" if contradictions else "undecided" if undecided else "rows proved"
-        text = ("proved: every certified solution is a true isolated solution of its taut set's "
-                f"system within certified_radius; {n_phys} physical (consistency and stability "
-                f"proved); completeness not proved: {scope}")  # fmt: skip
-        if status == "contradiction":
-            text = "CONTRADICTION: the table and the proof differ"
-        return status, f"{text}; {tail}"
-    found = sum(1 for boxes in proof.roots.values() if boxes)
-    bound = proof.longest_excluded * length
-    where = (f"with every spring longer than {bound:.3g}" if bound > 0
-             else "(no spring with a free length reaches zero length)")  # fmt: skip
-    status = "contradiction" if contradictions else "undecided" if undecided else "proved"
-    text = (f"proved: exactly {found} equilibria {where}; consistency and stability of each "
-            "proved (ball LDL^T of the reduced Hessian)")  # fmt: skip
+        text = (f"proved: every certified solution is a true isolated solution of its taut "
+                f"set's system within certified_radius; {len(_proved_equilibria(rows))} "
+                f"physical (consistency and stability proved); completeness not proved: "
+                f"{scope}")  # fmt: skip
+        return status, f"{'not proved: ' + failed + '; ' if failed else ''}{text}; {tail}"
+    text = (f"proved: exactly {_found(proof)} equilibria {where}; consistency and stability of "
+            "each proved (ball LDL^T of the reduced Hessian)")  # fmt: skip
     if status == "undecided":
-        text = (
-            f"not proved: {len(proof.undecided)} boxes undecided; {found} equilibria proved {where}"
-        )
-    elif status == "contradiction":
-        text = f"CONTRADICTION: the table and the proof differ ({found} equilibria proved {where})"
+        boxes = f"{len(proof.undecided)} boxes undecided" if proof.undecided else ""
+        text = (f"not proved: {'; '.join(t for t in (boxes, failed) if t)}; {_found(proof)} "
+                f"equilibria proved {where}")  # fmt: skip
     return status, f"{text}; {tail}"
+
+
+def _found(proof) -> int:
+    return sum(1 for boxes in proof.roots.values() if boxes)

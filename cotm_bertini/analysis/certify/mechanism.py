@@ -30,6 +30,11 @@ from .torus import arb_params, box, branch_and_bound, enclosures, krawczyk_2d
 SHORT = 1e-3  # springs shorter than this (times L3) are set aside: V is not smooth at length 0
 MIN_WIDTH = 1e-4  # radians: the smallest box away from a known equilibrium
 ROOT_BOX = 1e-7  # radians: the half-width of the box proving each equilibrium
+ROOT_FAILED = "root inclusion: the Krawczyk test failed in every box tried"
+KIND_FAILED = (
+    "kind: the signs of the interval Hessian's determinant and first entry over the 1e-7 rad "
+    "box are not decided"
+)
 METHODS = {
     "curve": "Krawczyk (complex balls) per solution; completeness: the relaxed equilibria by "
     "branch and bound with Krawczyk on d_i^2 = L0_i^2, the others along the parallel curve "
@@ -56,7 +61,10 @@ class Certificate:
     certified_radius: np.ndarray  # the box half-width (normalised units), NaN if not proved
     proved_equilibria: int
     kinds: dict[int, str]  # solution_id -> kind proved by the interval Hessian
-    shortest_spring: float  # every equilibrium with both springs longer than this is proved
+    # Every equilibrium whose springs with free lengths are all longer than this is proved
+    # (`spring_bound`: the most the shortest spring may be in a box set aside; with none set
+    # aside, a proved lower bound of those springs' lengths in every pose, or 0).
+    shortest_spring: float
     boxes: int
     excluded_boxes: int
     undecided_boxes: list[tuple]
@@ -64,6 +72,8 @@ class Certificate:
     seconds: float = 0.0
     timings: dict[str, float] = field(default_factory=dict)  # rows, equilibria, completeness
     method: str = "curve"
+    # solution_id -> the step that failed for a real nonsingular row not fully proved
+    not_proved: dict[int, str] = field(default_factory=dict)
 
     def record(self) -> dict:
         """The run.json `certificate` block."""
@@ -82,6 +92,7 @@ class Certificate:
             "excluded_boxes": self.excluded_boxes,
             "undecided_boxes": [[float(v) for v in q] for q in self.undecided_boxes],
             "contradictions": self.contradictions,
+            "not_proved": {str(k): v for k, v in self.not_proved.items()},
             "seconds": self.seconds,
             "timings": self.timings,
         }
@@ -137,7 +148,7 @@ def certify_table(
     t_known = time.perf_counter()
     proof = _completeness(params, known, short * params.L3, min_width, method)
     t_done = time.perf_counter()
-    bound = proof.longest_excluded
+    bound, meaning = spring_bound(proof)
     contradictions = [
         f"a critical point of V in gamma1 {math.degrees(q[0]):.6f}..{math.degrees(q[1]):.6f}, "
         f"gamma2 {math.degrees(q[2]):.6f}..{math.degrees(q[3]):.6f} deg is not in the table"
@@ -145,20 +156,30 @@ def certify_table(
     ]
     contradictions += duplicates(known)
     found = {sid for sid, boxes in proof.roots.items() if boxes}
-    contradictions += _unmatched_rows(params, table, found | set(), unproved, bound)
+    aside = bound if meaning == "aside" else 0.0
+    contradictions += _unmatched_rows(params, table, found | set(), unproved, aside)
     contradictions += kind_differences(table, kinds)
     singular = np.asarray(table["singular"], dtype=bool)
     open_rows = int((~certified & ~singular).sum())
     undecided = bool(proof.undecided) or open_rows > 0 or "undecided" in kinds.values()
     status = "contradiction" if contradictions else "undecided" if undecided else "proved"
-    statement = _statement(len(found), bound, certified, singular, status, proof, open_rows)
+    where = spring_clause(bound, meaning, " m", "both springs")
+    failed = {int(s): ROOT_FAILED for s in np.asarray(table["solution_id"])[~certified & ~singular]}
+    failed.update({s: KIND_FAILED for s, k in kinds.items() if k == "undecided"})
+    statement = _statement(len(found), where, certified, singular, status, proof, open_rows)
+    statement += f"; not proved: {not_proved_text(failed)}" if failed else ""
     timings = {"rows": t_rows - start, "equilibria": t_known - t_rows,
                "completeness": t_done - t_known}  # fmt: skip
     return Certificate(
         status, statement, certified, radius, len(found), kinds, bound, proof.boxes,
         len(proof.excluded), proof.undecided, contradictions, time.perf_counter() - start,
-        timings, method,
+        timings, method, dict(sorted(failed.items())),
     )  # fmt: skip
+
+
+def not_proved_text(failed: dict[int, str]) -> str:
+    """The rows not proved, each with the step that failed ('' for none)."""
+    return "; ".join(f"solution {s} ({why})" for s, why in sorted(failed.items()))
 
 
 def _completeness(params: Params, known: list[Known], short: float, min_width: float,
@@ -222,12 +243,43 @@ def kind_differences(table, kinds: dict[int, str]) -> list[str]:
     return out
 
 
-def _statement(n, bound, certified, singular, status, proof, open_rows) -> str:
-    where = (
-        f"with both springs longer than {bound:.3g} m"
-        if bound > 0
-        else "(no spring with a free length reaches zero length)"
-    )
+def spring_bound(proof) -> tuple[float, str]:
+    """(the bound on the springs with free lengths that a completeness search proves, what it
+    is): 'aside' (boxes were set aside: the most the shortest spring may be in any of them),
+    'floor' (none: a lower bound of every such spring's length over every box searched, so
+    none reaches zero length), 'none' (no spring has a free length: 0) or 'open' (one may reach
+    zero length in an undecided box: 0). Either way every equilibrium whose springs are all
+    longer than the bound is proved."""
+    if proof.excluded:
+        return proof.longest_excluded, "aside"
+    if proof.shortest_length == math.inf:
+        return 0.0, "none"
+    return (proof.shortest_length, "floor") if proof.shortest_length > 0 else (0.0, "open")
+
+
+def spring_clause(bound: float, meaning: str, unit: str = "", springs: str = "every spring",
+                  ) -> str:  # fmt: skip
+    """The statement's words for `spring_bound` (an upper bound rounded up, a lower bound
+    rounded down, to three digits)."""
+    if meaning == "aside":
+        return f"with {springs} longer than {_three_digits(bound, up=True)}{unit}"
+    if meaning == "floor":
+        return (f"(every spring with a free length is longer than "
+                f"{_three_digits(bound, up=False)}{unit} in every pose: none reaches zero "
+                "length)")  # fmt: skip
+    if meaning == "none":
+        return "(no spring has a free length)"
+    return "(a spring with a free length may reach zero length in an undecided box)"
+
+
+def _three_digits(x: float, up: bool) -> str:
+    """x to three significant digits, rounded up or down (so a bound stays a bound)."""
+    step = 10.0 ** (math.floor(math.log10(x)) - 2)
+    n = math.ceil(x / step * (1 + 1e-12)) if up else math.floor(x / step * (1 - 1e-12))
+    return f"{n * step:.3g}"
+
+
+def _statement(n, where, certified, singular, status, proof, open_rows) -> str:
     text = f"proved: exactly {n} equilibria {where}; stability of each proved (interval Hessian)"
     if status == "undecided":
         text = (f"not proved: {len(proof.undecided)} boxes undecided, {open_rows} nonsingular "

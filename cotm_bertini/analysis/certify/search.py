@@ -44,6 +44,7 @@ from .curve import (
     springs,
     uniform_edges,
 )  # fmt: skip
+from .torus import length_floor
 
 TWO_PI = 2 * math.pi
 ROOT_MIN_WIDTH = 1e-10  # boxes around a known equilibrium are split down to this
@@ -74,6 +75,9 @@ class SearchProof:
     cover_boxes: int = 0  # boxes of the curve's quadtree
     leaves: int = 0
     longest_excluded: float = 0.0  # the shortest spring is at most this long in every one
+    # Every spring with a free length is at least this long over every box decided or left
+    # undecided (not set aside): these boxes cover C, on which each spring's shortest pose lies.
+    shortest_length: float = math.inf
     notes: list[str] = field(default_factory=list)
 
 
@@ -192,7 +196,18 @@ def _decide(state: _Search, q: tuple, balls: tuple, width: float, curve=None) ->
     `_along_curve` found or None): 'done' when no critical point lies in the box outside the
     known equilibria's regions, or when the box is set aside, or recorded as missing or
     undecided. `width`: the size that bisection reduces; `curve`: for a thin box whose C is a
-    graph over the whole piece, (axis, the piece's midpoint, the thin ball, the slope)."""
+    graph over the whole piece, (axis, the piece's midpoint, the thin ball, the slope). The
+    spring lengths over each box done and not set aside bound them from below
+    (`SearchProof.shortest_length`)."""
+    verdict, parts, along = _judge(state, q, balls, width, curve)
+    if verdict == "done":
+        free = [p[2] for p, f in zip(parts, state.sp.free, strict=True) if f]
+        state.proof.shortest_length = min(state.proof.shortest_length, length_floor(free))
+    return ("done" if verdict == "aside" else verdict), parts, along
+
+
+def _judge(state: _Search, q: tuple, balls: tuple, width: float, curve=None) -> tuple:
+    """`_decide`, with 'aside' for a box set aside."""
     sp, proof = state.sp, state.proof
     parts = spring_parts(sp, *balls, second=True)
     size = max(q[1] - q[0], q[3] - q[2])  # a thin box may be taller than its piece
@@ -201,7 +216,7 @@ def _decide(state: _Search, q: tuple, balls: tuple, width: float, curve=None) ->
         proof.excluded.append(q)
         shortest = min(float(p[2].upper()) for p, free in zip(parts, sp.free, strict=True) if free)
         proof.longest_excluded = max(proof.longest_excluded, math.sqrt(shortest))
-        return "done", parts, None
+        return "aside", parts, None
     outcome, along = "split", None
     if near == "":
         grad = gradient(sp, parts)

@@ -26,6 +26,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from ...params import PARAM_NAMES, Params
+from ...progress import Progress
 from ..energy_terms import gradient_hessian
 
 TWO_PI = 2 * math.pi
@@ -77,6 +78,8 @@ class TorusProof:
     excluded: list[tuple]  # boxes where a spring may be shorter than `short`, set aside
     boxes: int = 0
     longest_excluded: float = 0.0  # the shortest spring is at most this long in every one
+    # Every spring with a free length is at least this long over every box not set aside.
+    shortest_length: float = math.inf
     notes: list[str] = field(default_factory=list)
 
 
@@ -218,10 +221,11 @@ def torus_search(
 ) -> TorusProof:
     """Decide every box of the torus [0, 2 pi]^n (see the module docstring). Boxes where a
     spring with L0 > 0 is shorter than `short` are set aside (split to `min_width` where they
-    may only be); `proof.longest_excluded` bounds the spring length over them."""
+    may only be); `proof.longest_excluded` bounds the spring length over them, and
+    `proof.shortest_length` the spring lengths from below over every other box."""
     from flint import arb
 
-    zero, limit = arb(0), arb(short) ** 2
+    limit = arb(short) ** 2
     # At the smallest width, a spring this short still makes the enclosures of the 1/d terms
     # too wide to decide: such boxes are set aside too (the reported bound covers them).
     wide = (arb(short) + 3 * arb(land.length_unit) * arb(min_width)) ** 2
@@ -232,8 +236,12 @@ def torus_search(
     cells = list(zip(edges[:-1], edges[1:], strict=True))
     stack = [tuple(v for c in choice for v in c) for choice in itertools.product(cells,
              repeat=land.n)]  # fmt: skip
+    # How far: the share of the torus in boxes decided (neither on the stack nor split).
+    report, pending = Progress("certificate search", 1.0, "of the poses decided"), 1.0
     while stack:
+        report.set(1.0 - pending, note=f"{proof.boxes} boxes")
         q = stack.pop()
+        pending -= _share(q)
         proof.boxes += 1
         balls = box(*q)
         width = max(q[2 * j + 1] - q[2 * j] for j in range(land.n))
@@ -244,30 +252,67 @@ def torus_search(
             shortest = min(float(dd.upper()) for dd in lengths)
             proof.longest_excluded = max(proof.longest_excluded, math.sqrt(shortest))
             continue
-        if not near:
-            grad, _ = land.enclose(balls, hessian=False)
-            if not all(g.contains(zero) for g in grad):
-                continue
-            verdict, _k = krawczyk_box(land, q)
-            if verdict == "none":
-                continue
-            inside, partial = _where(bounds, q)
-            if verdict == "one":
-                if len(inside) == 1 and not partial:
-                    proof.roots[inside[0]].append(q)
-                    continue
-                if not inside and not partial:
-                    proof.missing.append(q)
-                    continue
-            # Around a known equilibrium (a badly conditioned Hessian wants small boxes) split on.
-            if (inside or partial or _close(centres, q, 4 * min_width)) and width > ROOT_MIN_WIDTH:
+        outcome = _visit(land, q, balls, not near, (bounds, centres, min_width), proof)
+        if outcome != "done":
+            floor = ROOT_MIN_WIDTH if outcome == "root" else _floor(lengths, min_width,
+                                                                    land.length_unit)  # fmt: skip
+            if width > floor:
                 stack.extend(_split(q))
+                pending += _share(q)
                 continue
-        if width <= _floor(lengths, min_width, land.length_unit):
             proof.undecided.append(q)
-            continue
-        stack.extend(_split(q))
+        # A leaf of the search (decided or undecided): its lengths bound them from below.
+        proof.shortest_length = min(proof.shortest_length, length_floor(lengths))
+    report.set(1.0, note=f"{proof.boxes} boxes")  # the stack is empty: every box decided
+    report.close()
     return proof
+
+
+def _share(q: tuple) -> float:
+    """The share of the torus [0, 2 pi]^n that the box q covers."""
+    return math.prod((q[2 * j + 1] - q[2 * j]) / TWO_PI for j in range(len(q) // 2))
+
+
+def length_floor(squares: list) -> float:
+    """A float at most the smallest length whose square lies in one of these balls (0 if one
+    may be 0 or less; inf for none), rounded down."""
+    from flint import arb
+
+    out = math.inf
+    for dd in squares:
+        low = dd.lower()
+        out = min(out, 0.0 if not low > 0 else float(arb(low).sqrt().lower()))
+    return math.nextafter(out, 0.0) if 0 < out < math.inf else out
+
+
+def _visit(land: Landscape, q: tuple, balls: tuple, smooth: bool, known: tuple,
+           proof: TorusProof) -> str:  # fmt: skip
+    """'done' (the box holds no critical point, or one matched to a known equilibrium, or one
+    recorded as missing), 'split', or 'root' (split on down to ROOT_MIN_WIDTH: a known
+    equilibrium is in or near the box; undecided below it). `smooth`: every spring with a free
+    length is longer than the limit over the box; `known`: (enclosure bounds, centres,
+    min_width)."""
+    if not smooth:
+        return "split"
+    grad, _ = land.enclose(balls, hessian=False)
+    if not all(g.contains(0) for g in grad):
+        return "done"
+    verdict, _k = krawczyk_box(land, q)
+    if verdict == "none":
+        return "done"
+    bounds, centres, min_width = known
+    inside, partial = _where(bounds, q)
+    if verdict == "one":
+        if len(inside) == 1 and not partial:
+            proof.roots[inside[0]].append(q)
+            return "done"
+        if not inside and not partial:
+            proof.missing.append(q)
+            return "done"
+    # Around a known equilibrium (a badly conditioned Hessian wants small boxes) split on.
+    if inside or partial or _close(centres, q, 4 * min_width):
+        return "root"
+    return "split"
 
 
 def _floor(lengths: list, min_width: float, length_unit: float) -> float:

@@ -283,16 +283,24 @@ FRAMEWORK_EVENTS = {
     "kind": "fold (the number of physical equilibria changes by two: a pair is born or meets "
     "and vanishes), physical_change (it changes by one: a length or a cable reaches its limit) "
     "or stability_change (the number of stable ones changes; at a fold too)",
-    "branches": "the branch ids at the neighbouring sweep point of the rows involved (a+b)",
+    "branches": "the branch ids of the rows involved (a+b) at the neighbouring sweep point where "
+    "they exist: its physical rows nearest in pose to the event",
     "<param>": "the event's parameter value: the middle of the final bisection bracket",
     "pose columns": "BODY.angle_deg (planar), BODY.qw ... (spatial), NODE.x ...: the mean pose "
-    "of the merging equilibria at the bracket's end where they are real",
+    "of the equilibria that appear or vanish, at the bracket's end where they are real (those "
+    "with no counterpart at the other end); of a stability change alone, of the row whose "
+    "smallest eigenvalue is nearest 0",
     "hess_min_eig": "the largest |smallest reduced-Hessian eigenvalue| of those equilibria there "
-    "(tends to 0 at a fold)",
-    "refined": "every probe of the bisection was a complete solve (status ok)",
-    "bracket": "the final bisection bracket's width (the value's accuracy)",
+    "(tends to 0 at a fold of a minimum and a saddle; at a fold of two saddles the eigenvalue "
+    "that crosses 0 is another one)",
+    "refined": "every probe that placed an end of the bracket was a complete solve (status ok); "
+    "a probe that sees the event itself (counts matching neither end, with a degenerate row or "
+    "a failed check: at a fold, the merging pair taken as one root) places no end",
+    "bracket": "the final bisection bracket's width (the value's accuracy): 1e-9 relative, or as "
+    "narrow as the probes that see the event allow",
     "description": "what happens, in words",
-    "lo, hi": "the sweep points on either side",
+    "lo, hi": "the sweep points on either side (where the counts change twice between them, "
+    "each event is found and carries both)",
 }
 
 

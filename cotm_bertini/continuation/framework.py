@@ -86,10 +86,18 @@ def pose_names(fw: Framework) -> list[str]:
 
 
 def match_coordinates(fw: Framework, table) -> np.ndarray:
-    """Coordinates of each row for joining branches: (cos, sin) of every planar body's angle,
-    quaternions, node positions and link lengths in units of the framework's largest length
-    (real parts: a framework's table holds no imaginary parts), and each row's distance from
-    the real plane, signed to tell a complex-conjugate pair apart."""
+    """Coordinates of each row for joining branches: its `pose_coordinates` and its distance
+    from the real plane, signed to tell a complex-conjugate pair apart."""
+    coords = pose_coordinates(fw, table)
+    cols = list(coords.T)
+    cols.append(_pair_sides(table, cols))
+    return np.stack(cols, axis=1).astype(complex)
+
+
+def pose_coordinates(fw: Framework, table) -> np.ndarray:
+    """(rows, coordinates): (cos, sin) of every planar body's angle, quaternions, node
+    positions and link lengths in units of the framework's largest length (real parts: a
+    framework's table holds no imaginary parts)."""
     from ..model.framework.units import units
 
     length = units(fw)[0]
@@ -102,8 +110,7 @@ def match_coordinates(fw: Framework, table) -> np.ndarray:
             cols.append(values / (1.0 if ".q" in name else length))
     for link in fw.links:
         cols.append(np.asarray(table[f"{link.name}.length"], dtype=float) / length)
-    cols.append(_pair_sides(table, cols))
-    return np.stack(cols, axis=1).astype(complex)
+    return np.stack(cols, axis=1)
 
 
 def _pair_sides(table, cols: list[np.ndarray]) -> np.ndarray:

@@ -191,7 +191,7 @@ def test_a_failed_attempt_is_retried_with_a_new_seed(tmp_path, fixtures_dir):
     attempts = rec["details"]["attempts"]
     assert [a["ok"] for a in attempts] == [False, True]
     assert attempts[1]["settings"]["RandomSeed"] != "5"
-    assert "TrackTolBeforeEG: 1e-07;" in (run / "input").read_text()
+    assert "TrackTolBeforeEG: 1.0e-7;" in (run / "input").read_text()
     assert (run / "failed-attempt-1" / "input").is_file()
 
 

@@ -321,8 +321,9 @@ def test_cotm_relaxed_folds_against_plain_geometry_and_the_closed_form():
     cs = curve_system(fw.replace(L01=7.0, L02=7.0), (), "L01", "L02", RELAXED)
     axes = ("L01", window), ("L02", window)
     with worker_pool(1) as run:
-        curves, info = ff._find(fw, cs, axes, cb.Settings(), "auto", run)
-        table, _, about = ff._rows(fw, curves, ("L01", "L02"), 0, run)
+        work = ff._Work(run, 1, "relaxed folds")
+        curves, info = ff._find(fw, cs, axes, cb.Settings(), "auto", work)
+        table, _, about = ff._rows(fw, curves, ("L01", "L02"), 0, work)
     assert info["seed_route"] == "witness" and info["lost_paths"] == 0
     assert about["artefacts"] == 0 and len(table) > 500 and table["physical"].all()
     assert table["changes_stable_count"].all() and set(table["kind"]) == {"fold"}

@@ -161,6 +161,9 @@ def design_map(
     from .sweeps import sweep
 
     (x, xr), (y, yr), points = _axes(model, axes, l01, l02, points)
+    for a in xr:  # the window's corners validated before any work is announced or done
+        for b in yr:
+            model.replace(**{x: a, y: b})
     t0 = time.perf_counter()
     say(f"map: fold curves in the window {x} {xr[0]:g}..{xr[1]:g}, {y} {yr[0]:g}..{yr[1]:g}")
     folds, fold_record = _fold_curves(model, x, xr, y, yr, settings, workers)

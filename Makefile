@@ -57,7 +57,8 @@ stress: $(STAMP) phcpack
 	  tests/test_scaleout.py::test_paper_generic_set_split_equals_bertinis \
 	  tests/test_framework_map.py \
 	  tests/test_framework_folds.py \
-	  tests/test_numbers_and_limits.py::test_map_through_a_point_at_1e_05
+	  tests/test_numbers_and_limits.py::test_map_through_a_point_at_1e_05 \
+	  tests/test_monodromy.py tests/test_certify_agreement.py
 
 bench: $(STAMP) phcpack
 	$(BIN)/python bench/run_all.py

@@ -73,7 +73,13 @@ def _bertini():
 
 
 def _code(m) -> str:
-    return str(m.endgame_success_code).rsplit(".", 1)[-1]
+    """A path's outcome: the endgame's success code, or the pre-endgame one when the endgame
+    never started (a path that went to infinity before it reads NeverStarted there: lost)."""
+    code = str(m.endgame_success_code).rsplit(".", 1)[-1]
+    if code == "NeverStarted":
+        before = str(m.pre_endgame_success_code).rsplit(".", 1)[-1]
+        return code if before == _SUCCESS else before
+    return code
 
 
 def _points(pts) -> np.ndarray:

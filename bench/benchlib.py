@@ -154,3 +154,29 @@ def multihomogeneous_bezout(system, groups: list[list[str]]) -> int:
         product *= sum(d * zj for d, zj in zip(degs, z, strict=True))
     monomial = sp.Mul(*[zj ** len(g) for zj, g in zip(z, groups, strict=True)])
     return int(sp.Poly(sp.expand(product), *z).coeff_monomial(monomial))
+
+
+def example_system(name: str):
+    """The first taut set's system of examples/<name>.toml, its start centre and groups."""
+    import cotm_bertini as cb
+    from cotm_bertini.model.framework.compiled import framework_system, variable_groups
+    from cotm_bertini.model.framework.units import normalized_slots
+    from cotm_bertini.point import taut_sets
+
+    fw = cb.Framework.from_toml(BENCH.parent / "examples" / f"{name}.toml")
+    fs = next(f for f in (framework_system(fw, t) for t in taut_sets(fw)) if not f.free)
+    centre = normalized_slots(fw.at_defaults())
+    return fs.ps, {n: centre[n] for n in fs.ps.parameters}, variable_groups(fs)
+
+
+def same_points(a: np.ndarray, b: np.ndarray, tol: float = 1e-8) -> bool:
+    """The two sets of points agree (each row of a has a distinct match in b, relative tol)."""
+    if a.shape != b.shape:
+        return False
+    left = list(range(len(b)))
+    for p in a:
+        d = [np.abs(b[k] - p).max() / (1 + np.abs(p).max()) for k in left]
+        if min(d) > tol:
+            return False
+        left.pop(int(np.argmin(d)))
+    return True

@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from benchlib import BENCH, show, write_csv
+from benchlib import BENCH, example_system, same_points, show, write_csv
 
 ROOT = BENCH.parent
 CASES = {"case1": (True, True), "case2": (False, True), "case3": (False, False)}
@@ -36,28 +36,7 @@ def _system(name: str):
         from cotm_bertini.model.compiled import parametric_system
 
         return parametric_system(CASES[name]), START_CENTRE, None
-    import cotm_bertini as cb
-    from cotm_bertini.model.framework.compiled import framework_system, variable_groups
-    from cotm_bertini.model.framework.units import normalized_slots
-    from cotm_bertini.point import taut_sets
-
-    fw = cb.Framework.from_toml(ROOT / "examples" / f"{name}.toml")
-    fs = next(f for f in (framework_system(fw, t) for t in taut_sets(fw)) if not f.free)
-    centre = normalized_slots(fw.at_defaults())
-    return fs.ps, {n: centre[n] for n in fs.ps.parameters}, variable_groups(fs)
-
-
-def _same(a: np.ndarray, b: np.ndarray, tol: float = 1e-8) -> bool:
-    """The two sets of points agree (each row of a has a distinct match in b, relative tol)."""
-    if a.shape != b.shape:
-        return False
-    left = list(range(len(b)))
-    for p in a:
-        d = [np.abs(b[k] - p).max() / (1 + np.abs(p).max()) for k in left]
-        if min(d) > tol:
-            return False
-        left.pop(int(np.argmin(d)))
-    return True
+    return example_system(name)
 
 
 def _row(name: str, seed: int) -> dict:
@@ -76,7 +55,7 @@ def _row(name: str, seed: int) -> dict:
         "N": len(gs.points), "N_aug": m.augmented, "loops": m.loops,
         "mono_paths": m.paths, "mono_s": m.seconds, "mono_cpu_s": m.cpu_seconds,
         "trace_residual": m.trace_residual, "complete": m.complete,
-        "failed_paths": m.failed_paths, "same_set": _same(m.points, gs.points),
+        "failed_paths": m.failed_paths, "same_set": same_points(m.points, gs.points),
         "cpu_ratio": m.cpu_seconds / max(gs.route.get("cpu_seconds", np.nan), 1e-9),
         "load_avg_1min": os.getloadavg()[0],
     }  # fmt: skip

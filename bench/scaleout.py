@@ -15,37 +15,10 @@ import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
-from benchlib import BENCH, show, write_csv
+from benchlib import BENCH, example_system, same_points, show, write_csv
 
 ROOT = BENCH.parent
-
-
-def _system(name: str):
-    """The first taut set's system of examples/<name>.toml, its start centre and groups."""
-    import cotm_bertini as cb
-    from cotm_bertini.model.framework.compiled import framework_system, variable_groups
-    from cotm_bertini.model.framework.units import normalized_slots
-    from cotm_bertini.point import taut_sets
-
-    fw = cb.Framework.from_toml(ROOT / "examples" / f"{name}.toml")
-    fs = next(f for f in (framework_system(fw, t) for t in taut_sets(fw)) if not f.free)
-    centre = normalized_slots(fw.at_defaults())
-    return fs.ps, {n: centre[n] for n in fs.ps.parameters}, variable_groups(fs)
-
-
-def _same(a: np.ndarray, b: np.ndarray, tol: float = 1e-8) -> bool:
-    """The two sets of points agree (each row of a has a distinct match in b, relative tol)."""
-    if a.shape != b.shape:
-        return False
-    left = list(range(len(b)))
-    for p in a:
-        d = [np.abs(b[k] - p).max() / (1 + np.abs(p).max()) for k in left]
-        if min(d) > tol:
-            return False
-        left.pop(int(np.argmin(d)))
-    return True
 
 
 def _row(route: str, gs, wall: float, reference) -> dict:
@@ -55,7 +28,7 @@ def _row(route: str, gs, wall: float, reference) -> dict:
             "cpu_s": gs.route.get("cpu_seconds", float("nan")),
             "chunks": gs.route.get("chunks", 1),
             "retracked_adaptive": gs.route.get("retracked_adaptive", "-"),
-            "same_set_as_bertini": "-" if reference is None else _same(gs.points, reference),
+            "same_set_as_bertini": "-" if reference is None else same_points(gs.points, reference),
             "load_avg_1min": os.getloadavg()[0]}  # fmt: skip
 
 
@@ -70,7 +43,7 @@ def main() -> None:
 
     from cotm_bertini.backends.homotopy import generic_set
 
-    ps, centre, groups = _system(opts.example)
+    ps, centre, groups = example_system(opts.example)
     kw = {"use_cache": False, "centre": centre, "groups": groups}
     t0 = time.perf_counter()
     ref = generic_set(ps, 1, **kw)

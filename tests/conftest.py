@@ -8,6 +8,7 @@ import sys
 from functools import cache
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -69,3 +70,16 @@ def run_cli(*args: str, env: dict | None = None, cwd: Path | None = None,
         timeout=timeout,
         preexec_fn=None if umask is None else (lambda: os.umask(umask)),
     )
+
+
+def same_sets(a: np.ndarray, b: np.ndarray, tol: float = 1e-8) -> bool:
+    """Every row of a matches a distinct row of b to `tol` (relative), and the sizes agree."""
+    if a.shape != b.shape:
+        return False
+    left = list(range(len(b)))
+    for p in a:
+        gaps = [np.abs(b[k] - p).max() / (1 + np.abs(p).max()) for k in left]
+        if not gaps or min(gaps) > tol:
+            return False
+        left.pop(int(np.argmin(gaps)))
+    return True

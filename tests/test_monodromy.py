@@ -12,7 +12,7 @@ from functools import cache
 
 import numpy as np
 import pytest
-from conftest import ROOT
+from conftest import ROOT, same_sets
 
 import cotm_bertini as cb
 from cotm_bertini.backends import monodromy as mono
@@ -47,19 +47,6 @@ def total_degree(system, groups=None) -> tuple[np.ndarray, int, int]:
         else:
             points.append([complex(point[k]) for k in order])
     return np.array(points, dtype=complex), len(points) + singular, singular
-
-
-def same_sets(a: np.ndarray, b: np.ndarray, tol: float = 1e-8) -> bool:
-    """Every row of a matches a distinct row of b to `tol` (relative), and the sizes agree."""
-    if a.shape != b.shape:
-        return False
-    left = list(range(len(b)))
-    for p in a:
-        gaps = [np.abs(b[k] - p).max() / (1 + np.abs(p).max()) for k in left]
-        if not gaps or min(gaps) > tol:
-            return False
-        left.pop(int(np.argmin(gaps)))
-    return True
 
 
 def framework(name: str):

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import sympy
-from conftest import ROOT, run_cli
+from conftest import ROOT, run_cli, same_sets
 
 import cotm_bertini as cb
 from cotm_bertini.backends import homotopy
@@ -185,19 +185,6 @@ def _centre(fw, fs) -> dict:
 
     centre = normalized_slots(fw.at_defaults())
     return {n: centre[n] for n in fs.ps.parameters}
-
-
-def same_sets(a: np.ndarray, b: np.ndarray, tol: float = 1e-8) -> bool:
-    """Every row of a matches a distinct row of b to `tol` relative, and the sizes agree."""
-    if a.shape != b.shape:
-        return False
-    left = list(range(len(b)))
-    for p in a:
-        d = [np.abs(b[k] - p).max() / (1 + np.abs(p).max()) for k in left]
-        if not d or min(d) > tol:
-            return False
-        left.pop(int(np.argmin(d)))
-    return True
 
 
 def assert_same_generic_set(own, theirs, start: str = "multihomogeneous") -> None:

@@ -195,9 +195,8 @@ def cost(fw, settings: Settings | None = None, *, sample: bool | None = True) ->
 def _sets(fw, seeds: tuple[int, ...]) -> tuple[list[SetCost], list[tuple]]:
     """Each taut set's SetCost and (system, groups, centre) of its generic solves, derived in
     order with "taut set k/n" in the derivation's progress lines."""
-    from ..backends.homotopy import generic_key
+    from ..backends.homotopy import generic_key, generic_path
     from ..backends.path_progress import path_count
-    from ..fs import cache_root
     from ..model.framework.compiled import framework_system, variable_groups
     from ..model.framework.units import normalized_slots
     from ..point import taut_sets
@@ -211,7 +210,7 @@ def _sets(fw, seeds: tuple[int, ...]) -> tuple[list[SetCost], list[tuple]]:
         centre = {n: slots[n] for n in fs.ps.parameters}
         cached = tuple(
             seed for seed in seeds
-            if (cache_root() / f"generic-{generic_key(fs.ps, seed, centre, groups)}.json").is_file()
+            if generic_path(generic_key(fs.ps, seed, centre, groups)).is_file()
         )  # fmt: skip
         free = bool(fs.free)
         paths = 0 if free else path_count(fs.ps, groups)

@@ -180,6 +180,11 @@ def generic_key(
     return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
 
+def generic_path(key: str) -> Path:
+    """Where the generic set of this key is cached."""
+    return cache_root() / f"generic-{key}.json"
+
+
 _LOADED: dict[tuple[int, int], GenericSet] = {}
 
 
@@ -211,7 +216,7 @@ def _load_or_solve(
     ps: ParametricSystem, seed: int, use_cache: bool, centre: dict, groups, scheduler=None
 ) -> GenericSet:
     key = generic_key(ps, seed, centre, groups)
-    path = cache_root() / f"generic-{key}.json"
+    path = generic_path(key)
     if use_cache and path.is_file():
         try:
             return replace(GenericSet.from_json(json.loads(path.read_text())), source="cache")

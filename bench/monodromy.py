@@ -2,7 +2,7 @@
 and the examples' first taut sets. For each: the current route (Bertini's total-degree or
 multihomogeneous start, one ZeroDimSolver call, use_cache=False): its paths, wall and CPU
 seconds, the generic count N; the monodromy route (backends/monodromy.py): the augmented
-count N'', loops, paths tracked, wall and CPU seconds, trace test residual, whether complete
+count N'', edges, paths tracked, wall and CPU seconds, trace test residual, whether complete
 and whether its set equals the current route's (to 1e-8).
 
 Usage: python bench/monodromy.py [--systems case1 case2 case3 zeeman double_pendulum]
@@ -52,7 +52,7 @@ def _row(name: str, seed: int) -> dict:
         "system": name, "unknowns": len(ps.variables),
         "start": "multihomogeneous" if groups else "total degree",
         "ab_paths": gs.paths, "ab_s": ab_initio, "ab_cpu_s": gs.route.get("cpu_seconds"),
-        "N": len(gs.points), "N_aug": m.augmented, "loops": m.loops,
+        "N": len(gs.points), "N_aug": m.augmented, "edges": m.edges,
         "mono_paths": m.paths, "mono_s": m.seconds, "mono_cpu_s": m.cpu_seconds,
         "trace_residual": m.trace_residual, "complete": m.complete,
         "failed_paths": m.failed_paths, "same_set": same_points(m.points, gs.points),

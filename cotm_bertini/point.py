@@ -97,9 +97,10 @@ def path_counts(
     }
 
 
-def _checks(morse: dict, counts: dict) -> tuple[str, tuple[str, ...]]:
-    """The status and the warnings of a solve: complete, or why equilibria may be missing."""
-    warnings = []
+def _checks(morse: dict, counts: dict, generic: list[str]) -> tuple[str, tuple[str, ...]]:
+    """The status and the warnings of a solve: complete, or why equilibria may be missing
+    (`generic`: why its generic set is incomplete, if it is)."""
+    warnings = list(generic)
     if not morse["ok"]:
         total = morse["euler_characteristic"]
         parts = [f"#min - #saddle + #max (+ zero-length maxima) = {total} != 0 on the torus"] * (
@@ -143,7 +144,9 @@ def solve_point(
         table = classify_columns(params, endpoints, tolerances)
         morse = morse_check(params, table)
     counts = path_counts(endpoints, table, tracked, lost)
-    status, warnings = _checks(morse, counts)
+    status, warnings = _checks(
+        morse, counts, details.get("homotopy", {}).get("generic_warnings", [])
+    )
     shape = {
         "variables": list(system.variables),
         "functions": list(system.names),

@@ -28,6 +28,7 @@ CONFIG_KEYS = {
 }
 
 ENGINES = ("homotopy", "cli")
+GENERIC_ROUTES = (None, "monodromy", "total-degree", "both")
 DEFAULT_CLI_TIMEOUT = 600.0
 
 # Options a Bertini input file can express but the in-process parameter homotopy cannot.
@@ -61,6 +62,9 @@ class Settings:
     # A Dask scheduler address: a generic set solved ab initio is split over its workers (where
     # the paths are tracked, not what is found: not part of a result's key).
     scheduler: str | None = None
+    # How a generic set is found (backends/generic.py): "monodromy", "total-degree" or "both";
+    # None: backends.generic.DEFAULT_ROUTE (total-degree for now).
+    generic: str | None = None
 
     def __new__(cls, *args: object, **values: object) -> Settings:
         """Refuse an unknown setting with ParameterError (not a bare TypeError)."""
@@ -93,8 +97,22 @@ class Settings:
             value = getattr(self, name)
             if value is not None and not value > 0:
                 raise ParameterError(f"{name} = {value!r}: must be > 0")
+        if self.generic not in GENERIC_ROUTES:
+            raise ParameterError(
+                f"generic = {self.generic!r}: expected 'monodromy', 'total-degree' or 'both'"
+            )
         if self.engine == "homotopy":
             self._refuse_cli_only()
+            if self.generic == "monodromy" and self.scheduler is not None:
+                raise ParameterError(
+                    f"generic = 'monodromy' with scheduler = {self.scheduler!r}: the monodromy "
+                    "route runs in one process; a scheduler splits the total-degree route"
+                )
+        elif self.generic is not None:
+            raise ParameterError(
+                f"generic = {self.generic!r}: the cli engine runs Bertini's own total-degree "
+                "solve (a generic set route is for engine='homotopy')"
+            )
         elif self.scheduler is not None:
             raise ParameterError(
                 f"scheduler = {self.scheduler!r}: splitting paths over Dask workers needs "
@@ -151,13 +169,14 @@ class Settings:
         """All settings, for run.json and cache keys (`scheduler` only when set, so that the
         sweep specs and keys written before it existed still match)."""
         out = asdict(self)
-        if out["scheduler"] is None:
-            del out["scheduler"]
+        for name in ("scheduler", "generic"):  # absent when unset: older keys still match
+            if out[name] is None:
+                del out[name]
         return out
 
     def result_key(self) -> dict:
         """The settings a result depends on (not the time limit, thread count or scheduler)."""
-        skip = ("timeout", "threads", "scheduler")
+        skip = ("timeout", "threads", "scheduler", "generic")  # every route: the same set
         return {k: v for k, v in self.as_dict().items() if k not in skip}
 
 

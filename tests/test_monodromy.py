@@ -3,7 +3,7 @@
 The reference generic sets come from Bertini's own total-degree / multihomogeneous solve
 (ZeroDimSolver, called here directly, not through the package's generic_set) of the same
 system at the same start parameters p0; the augmented fibre's reference is the same solve of
-G(x; c0, e0) = F(x) + M x + e0 itself.
+G(x; c0, e0) = F(x) + u (a . x) + e0 itself.
 """
 
 from __future__ import annotations
@@ -130,14 +130,14 @@ def test_stagnation_or_spent_loops_without_a_passing_trace_test_is_incomplete():
     ps = parametric_system(ZFL["case1"])
     stalled = mono.monodromy_generic(ps, SEED, trace_tol=0.0, max_stall=1)
     assert not stalled.complete
-    assert stalled.reason.startswith("stagnation: 1 fresh loops in a row found no new root")
+    assert stalled.reason.startswith("stagnation: 1 fresh edges in a row found no new root")
     assert stalled.augmented == monodromy("case1").augmented  # all found, none certified
     assert 0 < stalled.trace_residual < mono.TRACE_TOL
     with pytest.raises(cb.SolverError, match="stagnation"):
         stalled.generic_set("incomplete")  # never used as a generic set
-    spent = mono.monodromy_generic(ps, SEED, trace_tol=0.0, max_loops=1)
-    assert not spent.complete and spent.loops == 1
-    assert spent.reason.startswith("the loop budget (1 loops) is spent")
+    spent = mono.monodromy_generic(ps, SEED, trace_tol=0.0, max_edges=3)
+    assert not spent.complete and spent.edges == 3
+    assert spent.reason.startswith("the edge budget (3 edges) is spent")
 
 
 def test_monodromy_generic_set_tracks_to_a_target_as_the_total_degree_one():

@@ -90,11 +90,13 @@ def completeness(fw: Framework, table: dict, report: dict) -> dict:
             if not info["excluded"]:
                 warnings.append(f"taut set {label}: {info['note']}")
             continue
-        a, b = info["generic_counts"]
-        if a != b:
+        counts = info["generic_counts"]
+        if len(set(counts)) > 1:
             warnings.append(
-                f"taut set {label}: two independent generic solves disagree ({a} vs {b} roots)"
+                f"taut set {label}: two independent generic solves disagree "
+                f"({counts[0]} vs {counts[1]} roots)"
             )
+        warnings += [f"taut set {label}: {w}" for w in info.get("generic_warnings", [])]
         if info["lost"]:
             warnings.append(f"taut set {label}: {info['lost']} paths lost")
         if info["generic_singular"]:

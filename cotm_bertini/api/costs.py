@@ -1,13 +1,17 @@
 """What solving a framework will cost, said before it costs it (`cost`, `params --framework`,
 the first line of a solve).
 
-A framework is solved taut set by taut set; each taut set that does not move freely needs two
-generic solution sets (seeds s and s + SECOND_START, the second a cross-check of the first),
-each an ab-initio solve of as many paths as the multihomogeneous Bezout number of its variable
-groups. A generic set already in the cache costs nothing. The time a path takes is measured on
-the first paths of the largest taut set's generic solve itself (the same ZeroDimSolver call,
-stopped after SAMPLE_SECONDS): an estimate, and said to be one (paths differ in cost; on the
-examples the whole solve took 0.5 to 2 times the rate of its first paths).
+A framework is solved taut set by taut set; each taut set that does not move freely needs a
+generic solution set. By monodromy (`generic='monodromy'`, backends/generic.py) its paths follow
+the number of solutions, which no count knows before the solve: the statement gives the Bezout
+number as what the total-degree route would track, and no time estimate (the progress lines
+measure the rate as the paths finish). By the total-degree route it needs two (seeds s and
+s + SECOND_START, the second a cross-check of the first), each an ab-initio solve of as many
+paths as the multihomogeneous Bezout number of its variable groups. A generic set already in
+the cache costs nothing. The time a path takes is measured on the first paths of the largest
+taut set's generic solve itself (the same ZeroDimSolver call, stopped after SAMPLE_SECONDS):
+an estimate, and said to be one (paths differ in cost; on the examples the whole solve took
+0.5 to 2 times the rate of its first paths).
 """
 
 from __future__ import annotations
@@ -50,6 +54,7 @@ class Cost:
     rate_source: str
     measured: bool  # the rate was measured on sample paths (not a first guess)
     derive_seconds: float  # spent deriving equations to count the paths (cached from now on)
+    route: str = "total-degree"  # of the generic sets (backends.generic.route_of)
 
     @property
     def paths(self) -> int:
@@ -67,7 +72,10 @@ class Cost:
 
     @property
     def estimate(self) -> float:
-        """Seconds the generic sets still to solve take at the rate (an estimate)."""
+        """Seconds the generic sets still to solve take at the rate (an estimate; NaN by
+        monodromy, whose path count is not known before the solve)."""
+        if self.route == "monodromy" and self.paths_to_solve:
+            return float("nan")
         return self.paths_to_solve * self.seconds_per_path
 
     @property
@@ -90,6 +98,14 @@ class Cost:
         )
         if not self.paths_to_solve:
             return f"{text}; every generic set is in the cache already"
+        if self.route == "monodromy":
+            todo = sum(len(self.seeds) - len(s.cached) for s in solved)
+            return (
+                f"{self.name}: {len(self.sets)} taut set{'s' * (len(self.sets) != 1)}, "
+                f"{todo} generic set{'s' * (todo != 1)} to find by monodromy (its paths follow "
+                f"the number of solutions, not known before; the total-degree route would "
+                f"track {per} paths per set): the progress lines measure the rate"
+            )
         from ..progress import duration
 
         return (
@@ -166,20 +182,25 @@ def cost(fw, settings: Settings | None = None, *, sample: bool | None = True) ->
     taut set (kept in the cache for the solve). `sample`: False, a first guess only (from an
     earlier solve in this process, or a fixed prior); None, sample only when the first guess
     is beyond SAMPLE_FROM seconds."""
+    from ..backends.generic import route_of
     from ..backends.homotopy import SECOND_START
     from ..backends.path_progress import first_guess, remember
 
     settings = settings or Settings()
-    seeds = (settings.seed, settings.seed + SECOND_START)
+    route = route_of(settings)
+    seeds = (
+        (settings.seed,) if route == "monodromy" else (settings.seed, settings.seed + SECOND_START)
+    )
     t0 = time.perf_counter()
-    sets, systems = _sets(fw, seeds)
+    sets, systems = _sets(fw, seeds, route)
     derive_seconds = time.perf_counter() - t0
     todo = [k for k, s in enumerate(sets) if not s.free and len(s.cached) < len(seeds)]
     big = max(todo, key=lambda k: sets[k].paths) if todo else None
     rate, source = first_guess(*systems[big][:2]) if big is not None else (0.0, "nothing to do")
     source, measured = f"a first guess: {source}", False
     pending = sum(sets[k].paths * (len(seeds) - len(sets[k].cached)) for k in todo)
-    if big is not None and (sample or (sample is None and pending * rate > SAMPLE_FROM)):
+    wanted = sample or (sample is None and pending * rate > SAMPLE_FROM)
+    if big is not None and route != "monodromy" and wanted:
         ps, groups, centre = systems[big]
         rate, n = sample_rate(ps, groups, seeds[0], centre)
         source = (
@@ -189,13 +210,13 @@ def cost(fw, settings: Settings | None = None, *, sample: bool | None = True) ->
         )
         remember(ps, groups, rate, source)
         measured = True
-    return Cost(fw.name, tuple(sets), seeds, rate, source, measured, derive_seconds)
+    return Cost(fw.name, tuple(sets), seeds, rate, source, measured, derive_seconds, route)
 
 
-def _sets(fw, seeds: tuple[int, ...]) -> tuple[list[SetCost], list[tuple]]:
+def _sets(fw, seeds: tuple[int, ...], route: str) -> tuple[list[SetCost], list[tuple]]:
     """Each taut set's SetCost and (system, groups, centre) of its generic solves, derived in
     order with "taut set k/n" in the derivation's progress lines."""
-    from ..backends.homotopy import generic_key, generic_path
+    from ..backends.homotopy import generic_path
     from ..backends.path_progress import path_count
     from ..model.framework.compiled import framework_system, variable_groups
     from ..model.framework.units import normalized_slots
@@ -210,13 +231,23 @@ def _sets(fw, seeds: tuple[int, ...]) -> tuple[list[SetCost], list[tuple]]:
         centre = {n: slots[n] for n in fs.ps.parameters}
         cached = tuple(
             seed for seed in seeds
-            if generic_path(generic_key(fs.ps, seed, centre, groups)).is_file()
+            if generic_path(_key(fs.ps, seed, centre, groups, route)).is_file()
         )  # fmt: skip
         free = bool(fs.free)
         paths = 0 if free else path_count(fs.ps, groups)
         sets.append(SetCost(taut, len(fs.ps.variables), len(groups), paths, free, cached))
         systems.append((fs.ps, groups, centre))
     return sets, systems
+
+
+def _key(ps, seed: int, centre: dict, groups, route: str) -> str:
+    """The cache key of a generic set by this route (the monodromy one ignores groups)."""
+    from ..backends.homotopy import generic_key
+    from ..backends.monodromy import ROUTE
+
+    if route == "monodromy":
+        return generic_key(ps, seed, centre, route=ROUTE)
+    return generic_key(ps, seed, centre, groups)
 
 
 def announce(fw, settings: Settings) -> Cost | None:

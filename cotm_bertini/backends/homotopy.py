@@ -168,15 +168,17 @@ def generic_key(
     seed: int,
     centre: dict[str, float] | None = None,
     groups: list[list[str]] | None = None,
+    route: str | None = None,
 ) -> str:
-    """Content hash of what a generic set depends on: equations, seed, start, engine version."""
+    """Content hash of what a generic set depends on: equations, seed, start, engine version,
+    and the route when it is not the total-degree one (whose keys predate routes)."""
     start = {"centre": START_CENTRE if centre is None else centre, "spread": START_SPREAD}
     if groups is not None:
         start["groups"] = groups
-    blob = json.dumps(
-        {"system": ps.to_json(), "seed": seed, "bertini2": bertini2_version(), "start": start},
-        sort_keys=True,
-    )
+    what = {"system": ps.to_json(), "seed": seed, "bertini2": bertini2_version(), "start": start}
+    if route is not None:
+        what["route"] = route
+    blob = json.dumps(what, sort_keys=True)
     return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
 

@@ -137,15 +137,20 @@ def render_parameter_homotopy(
     target: dict[str, complex],
     detour: dict[str, complex] | None = None,
     texts: tuple[str, ...] | None = None,
+    twist: dict[str, complex] | None = None,
 ) -> str:
     """INPUT section of the homotopy moving the parameters from `start` (t=1) to `target` (t=0),
-    on a straight line, or bulging into the complex plane by `detour` * t (1 - t)."""
+    on a straight line, or bulging into the complex plane by `detour` * t (1 - t), plus
+    `twist` * t^2 (1 - t) for the parameters it names (their paths then loop, not go and come
+    back along one segment)."""
+    twist = twist or {}
     parameters = [
         {
             "name": n,
             "start": complex_number(start[n]),
             "target": complex_number(target[n]),
             "detour": complex_number(detour[n]) if detour else "",
+            "twist": complex_number(twist[n]) if n in twist else "",
         }
         for n in ps.parameters
     ]

@@ -12,11 +12,11 @@ from ..model.polynomial import ParametricSystem
 from ..params import Params
 from ..settings import Settings
 from .endpoints import Endpoints
+from .generic import disagreements, evidence_sets, generic_for, incomplete_sets, route_of
 from .homotopy import (
     SECOND_START,
     GenericSet,
     ab_initio,
-    generic_set,
     route_record,
     track,
     zero_length_roots,
@@ -56,7 +56,9 @@ def solve_target(
     user's units; the spring lengths are scaled back.
     """
     deadline = None if settings.timeout is None else time.perf_counter() + settings.timeout
-    gs = generic_set(ps, settings.seed, scheduler=settings.scheduler)
+    gs = generic_for(ps, settings.seed, settings)
+    # "both": the total-degree set of the same seed too, its count the cross-check.
+    sets = evidence_sets(ps, settings) if route_of(settings) == "both" else (gs,)
     unit = params.normalized()
     result, note = None, ""
     if warm is not None:
@@ -84,7 +86,8 @@ def solve_target(
         generic_key=gs.key,
         generic_paths=gs.paths,
         generic_finite=gs.finite_endpoints,
-        generic_route=route_record([gs], settings.scheduler),
+        generic_route=route_record(list(sets), settings.scheduler),
+        generic_warnings=incomplete_sets(sets) + disagreements(sets),
     )
     closed = zero_length_roots(params, ps.variables)
     return HomotopySolve(endpoints.concat(closed), info, gs, text, warm_next)
@@ -105,10 +108,7 @@ def from_generic(
     endpoints, rep = track(ps, gs, unit, settings, deadline)
     method = "parameter homotopy" + (" + adaptive retrack" if rep.retracked_adaptive else "")
     if rep.lost or rep.finite < len(gs.points):
-        gs2 = generic_set(
-            ps, settings.seed + SECOND_START, centre=centre, groups=groups,
-            scheduler=settings.scheduler,
-        )  # fmt: skip
+        gs2 = generic_for(ps, settings.seed + SECOND_START, settings, centre, groups)
         endpoints2, rep2 = track(ps, gs2, unit, settings, deadline)
         if rep2.lost == 0 and not rep.lost and rep2.finite == rep.finite:
             method += "; finite count confirmed from a second start"
@@ -131,17 +131,16 @@ def solve_parameters(
 ) -> HomotopySolve:
     """Every finite endpoint of `ps` at `target` (normalised parameter values), from the generic
     set around `centre`, with the fallbacks of solve_target; a second, independent generic set
-    is solved too and its count recorded (`info["generic_counts"]`): two ab-initio solves with
-    different random starts that agree are the completeness evidence of a framework solve.
+    is solved too when the route asks for one (backends.generic.evidence_sets), the counts
+    recorded (`info["generic_counts"]`): the trace test of the monodromy set, or two sets that
+    agree, are the completeness evidence of a framework solve.
     `groups`: variable groups of a multihomogeneous start for the ab-initio solves. `warm`: a
     neighbouring point's complete set (a sweep): Newton from it first, accepted only when it
     proves the set complete (`newton_continue`), else the generic set as without it."""
     deadline = None if settings.timeout is None else time.perf_counter() + settings.timeout
     centre = {n: centre[n] for n in ps.parameters}
-    gs, gs2 = (
-        generic_set(ps, s, centre=centre, groups=groups, scheduler=settings.scheduler)
-        for s in (settings.seed, settings.seed + SECOND_START)
-    )
+    sets = evidence_sets(ps, settings, centre, groups)
+    gs = sets[0]
     result, note = (None, "") if warm is None else newton_continue(ps, gs, warm, target)
     if result is not None:
         endpoints, info, text = result
@@ -168,8 +167,9 @@ def solve_parameters(
         generic_paths=gs.paths,
         generic_finite=gs.finite_endpoints,
         generic_singular=gs.singular_endpoints,
-        generic_counts=[len(gs.points), len(gs2.points)],
-        generic_route=route_record([gs, gs2], settings.scheduler),
+        generic_counts=[len(g.points) for g in sets],
+        generic_route=route_record(list(sets), settings.scheduler),
+        generic_warnings=incomplete_sets(sets),
     )
     return HomotopySolve(endpoints, info, gs, text, _next_start(gs, warm, target, endpoints, info))
 

@@ -95,6 +95,13 @@ def add_settings(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--threads", type=int, help="solver threads (default: every core)")
     p.add_argument(
+        "--generic",
+        choices=("monodromy", "total-degree", "both"),
+        help="how a generic solution set is found: monodromy, trace-tested; Bertini's "
+        "total-degree start, two seeds agree (default, for now); or both (the monodromy set "
+        "checked against the total-degree one)",
+    )
+    p.add_argument(
         "--bertini",
         metavar="PATH",
         help="a Bertini 1.x binary instead of bertini2 (implies --engine cli; also $COTM_BERTINI)",
@@ -176,7 +183,7 @@ def settings_from(args: argparse.Namespace) -> Settings:
     """Settings from the options the user gave (the others stay at their defaults)."""
     given = {
         name: getattr(args, name)
-        for name in ("seed", "engine", "mptype", "timeout", "threads", "bertini")
+        for name in ("seed", "engine", "mptype", "timeout", "threads", "bertini", "generic")
         if getattr(args, name, None) is not None
     }
     return Settings(**given)

@@ -87,18 +87,16 @@ def _key(spec, t: float) -> tuple[float, float]:
 
 
 def _generic_sets(task) -> None:
-    """Solve (or load) the equilibrium system's two generic sets that every crossing's solve
+    """Solve (or load) the equilibrium system's generic sets that every crossing's solve
     starts from (backends.target.solve_parameters), so that parallel workers find them cached
     rather than each solving them."""
-    from ..backends.homotopy import SECOND_START, generic_set
+    from ..backends.generic import evidence_sets
 
     fw, cs, settings = task
     fs = framework_system(fw.at_defaults(), cs.taut)
     slots = normalized_slots(fw.at_defaults())
     centre = {n: slots[n] for n in fs.ps.parameters}
-    for seed in (settings.seed, settings.seed + SECOND_START):
-        generic_set(fs.ps, seed, centre=centre, groups=variable_groups(fs),
-                    scheduler=settings.scheduler)  # fmt: skip
+    evidence_sets(fs.ps, settings, centre, variable_groups(fs))
 
 
 def _solve_line(task) -> dict:

@@ -128,10 +128,11 @@ def _pair_sides(table, cols: list[np.ndarray]) -> np.ndarray:
     return imag * np.concatenate([[1.0], np.where(twin, -1.0, 1.0)])
 
 
-def warm_generic_sets(fw_at, indices: list[int], seed: int, scheduler: str | None = None) -> None:
+def warm_generic_sets(fw_at, indices: list[int], settings) -> None:
     """Load (or solve) the generic sets of every taut set at the given grid points, once, so
-    worker processes start with them (a set solved now: split over `scheduler`, if given)."""
-    from ..backends.homotopy import SECOND_START, generic_set
+    worker processes start with them (by the route of `settings`: a total-degree set solved
+    now is split over its scheduler, if given)."""
+    from ..backends.generic import evidence_sets
     from ..model.framework.compiled import framework_system, variable_groups
     from ..model.framework.units import normalized_slots
     from ..point import taut_sets
@@ -144,7 +145,4 @@ def warm_generic_sets(fw_at, indices: list[int], seed: int, scheduler: str | Non
             if fs.free:
                 continue
             middle = {n: centre[n] for n in fs.ps.parameters}
-            for s in (seed, seed + SECOND_START):
-                generic_set(
-                    fs.ps, s, centre=middle, groups=variable_groups(fs), scheduler=scheduler
-                )
+            evidence_sets(fs.ps, settings, middle, variable_groups(fs))

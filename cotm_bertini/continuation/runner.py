@@ -203,18 +203,19 @@ def warm_generic_sets(spec: SweepSpec, scheduler: str | None = None) -> None:
     settings = Settings(**spec.settings)
     if settings.engine != "homotopy":
         return
-    scheduler = scheduler or settings.scheduler
+    if scheduler:
+        settings = settings.replace(scheduler=scheduler)
     if spec.framework is not None:
         from .framework import warm_generic_sets as framework_sets
 
-        framework_sets(spec.params_at, sorted({0, spec.size() - 1}), settings.seed, scheduler)
+        framework_sets(spec.params_at, sorted({0, spec.size() - 1}), settings)
         return
-    from ..backends.homotopy import generic_set
+    from ..backends.generic import generic_for
     from ..model.compiled import parametric_system
 
     structures = {spec.params_at(i).zfl for i in range(spec.size())}
     for zfl in sorted(structures):
-        generic_set(parametric_system(zfl), settings.seed, scheduler=scheduler)
+        generic_for(parametric_system(zfl), settings.seed, settings)
 
 
 def run_points(

@@ -1,0 +1,94 @@
+"""The generic-set routes (backends/generic.py, issue 28): settings honoured or refused, the
+monodromy route's evidence in run.json, a failed trace test reported as incomplete, a search
+interrupted and resumed from its checkpoint, and the two routes agreeing through cb.solve.
+
+The reference for "the same set" is Bertini's own total-degree solve (tests/test_monodromy.py's
+`total_degree`, which calls ZeroDimSolver directly, not the package's route)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from conftest import same_sets
+from test_monodromy import ZFL, total_degree
+
+import cotm_bertini as cb
+from cotm_bertini.backends import generic, monodromy
+from cotm_bertini.model.compiled import parametric_system
+
+
+def test_generic_setting_is_honoured_or_refused():
+    assert generic.route_of(cb.Settings()) == generic.DEFAULT_ROUTE
+    assert generic.route_of(cb.Settings(generic="monodromy")) == "monodromy"
+    assert generic.route_of(cb.Settings(scheduler="tcp://h:1")) == "total-degree"
+    assert generic.route_of(cb.Settings(generic="both")) == "both"
+    with pytest.raises(cb.ParameterError, match="generic = 'simplex'"):
+        cb.Settings(generic="simplex")
+    with pytest.raises(cb.ParameterError, match="monodromy route runs in one process"):
+        cb.Settings(generic="monodromy", scheduler="tcp://h:1")
+    with pytest.raises(cb.ParameterError, match="cli engine"):
+        cb.Settings(generic="monodromy", engine="cli")
+    # Not part of a result's key (every route gives the same set), absent from it when unset.
+    assert "generic" not in cb.Settings(generic="both").result_key()
+    assert "generic" not in cb.Settings().as_dict()
+
+
+def test_both_routes_through_solve_agree_and_record_their_evidence():
+    """case 2 solved with generic='both': the monodromy set and the total-degree set of the
+    same seed have the same count, the solve is complete, and run.json's record names the
+    monodromy route with a passing trace test."""
+    res = cb.solve(cb.Params.case("case2"), settings=cb.Settings(generic="both", seed=3))
+    assert res.status == "ok", res.warnings
+    mono, td = res.record["details"]["homotopy"]["generic_route"]["generic_sets"]
+    assert mono["route"] == "monodromy" and mono["complete"] and "route" not in td
+    assert (mono["seed"], td["seed"]) == (3, 3)
+    assert mono["evidence"] == ["trace test"] and mono["trace_residual"] < monodromy.TRACE_TOL
+    ps = parametric_system(ZFL["case2"])
+    gs = generic.monodromy_set(ps, 3)
+    points, _, _ = total_degree(ps.instantiate([gs.start[n] for n in ps.parameters]))
+    assert same_sets(gs.points, points)
+
+
+def test_a_failed_trace_test_makes_the_solve_incomplete(monkeypatch, tmp_path):
+    """A trace test that cannot pass (tolerance 0, stagnation after one fresh edge): the solve
+    still answers, its status is incomplete with the reason, and nothing is cached."""
+    monkeypatch.setenv("COTM_CACHE", str(tmp_path))
+    monkeypatch.setattr(generic, "_LOADED", {})
+    real = generic.monodromy_generic
+
+    def failing(*args, **kw):
+        return real(*args, **{**kw, "trace_tol": 0.0, "max_stall": 1})
+
+    monkeypatch.setattr(generic, "monodromy_generic", failing)
+    settings = cb.Settings(seed=5, generic="monodromy")
+    res = cb.solve(cb.Params.case("case1"), settings=settings, cache=False)
+    assert res.status == "incomplete"
+    assert any("stagnation" in w and "trace test" in w for w in res.warnings), res.warnings
+    assert not list(tmp_path.glob("generic-*.json"))
+
+
+def test_an_interrupted_search_resumes_from_its_checkpoint(monkeypatch, tmp_path):
+    """The search stopped by an interrupt after its first round of edges keeps what it found
+    in the checkpoint; the next call resumes from it (the roots found are not found again) and
+    ends with the set of an uninterrupted search; the checkpoint is removed once complete."""
+    ps = parametric_system(ZFL["case2"])
+    checkpoint = tmp_path / "monodromy.partial.json"
+    real = monodromy._trace
+    calls = []
+
+    def interrupt(aug, g):
+        calls.append(len(g.nodes[0]))
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(monodromy, "_trace", interrupt)
+    with pytest.raises(KeyboardInterrupt):
+        monodromy.monodromy_generic(ps, 2, checkpoint=checkpoint)
+    assert checkpoint.is_file() and calls[0] > 1
+    monkeypatch.setattr(monodromy, "_trace", real)
+    resumed = monodromy.monodromy_generic(ps, 2, checkpoint=checkpoint)
+    whole = monodromy.monodromy_generic(ps, 2)
+    assert resumed.complete and resumed.resumed == calls[0]
+    assert not checkpoint.exists()
+    assert same_sets(resumed.points, whole.points)
+    assert resumed.paths == whole.paths  # the same work, the first round not done twice
+    assert np.isfinite(resumed.trace_residual)

@@ -1,7 +1,9 @@
 """Frameworks (issue 18): each example's first solve (generic sets from scratch, in a fresh
 cache) and a later one, paths, and the paper's mechanism from cotm.toml against the built-in
 model, and the barriers of each solve (cb.barriers, issue 19). Usage: python
-bench/frameworks.py [--skip NAME ...] (the prism takes minutes)."""
+bench/frameworks.py [--skip NAME ...] [--generic ROUTE] (the prism takes minutes); ROUTE:
+monodromy, total-degree or both (default: the package's default route), the same for every
+solve of the run; the ratio first / later solve is the issue 28 target (<= 5)."""
 
 from __future__ import annotations
 
@@ -36,21 +38,24 @@ def _run(args: list[str], env: dict) -> float:
     return time.perf_counter() - t0
 
 
-def _row(name: str, env: dict) -> dict:
+def _row(name: str, env: dict, route: str | None) -> dict:
     import cotm_bertini as cb
 
     args = ["solve", "--framework", str(ROOT / "examples" / f"{name}.toml"), *EXAMPLES[name]]
+    args += ["--generic", route] if route else []
     first = _run(args, env)
     later = min(_run(args, env) for _ in range(3))
     os.environ["COTM_CACHE"] = env["COTM_CACHE"]
     fw = cb.Framework.from_toml(ROOT / "examples" / f"{name}.toml")
     sets = dict(a.split("=") for a in EXAMPLES[name][1::2])
-    res = cb.solve(fw.replace(**{k: float(v) for k, v in sets.items()}))
+    res = cb.solve(fw.replace(**{k: float(v) for k, v in sets.items()}),
+                   settings=cb.Settings(generic=route))  # fmt: skip
     c = res.counts
     t0 = time.perf_counter()
     found = cb.barriers(res)  # every index-1 saddle's two descents (issue 19)
     barriers_s = time.perf_counter() - t0
-    return {"example": name, "first_solve_s": first, "later_solve_s": later,
+    return {"example": name, "route": route or "default", "first_solve_s": first,
+            "later_solve_s": later, "first_over_later": first / later,
             "generic_paths": c["generic_paths"], "paths_tracked": c["paths_tracked"],
             "physical": c["physical"], "stable": c["stable"], "status": res.status,
             "morse": res.morse.get("manifold", "n/a"), "barriers_s": barriers_s,
@@ -62,13 +67,18 @@ def main() -> None:
     """Print and write bench/results/frameworks.csv."""
     ap = argparse.ArgumentParser()
     ap.add_argument("--skip", nargs="*", default=[])
+    ap.add_argument("--generic", choices=("monodromy", "total-degree", "both"))
     opts = ap.parse_args()
     env = {**os.environ, "COTM_CACHE": tempfile.mkdtemp(prefix="cotm-bench-fw-")}
-    rows = [_row(n, env) for n in EXAMPLES if n not in opts.skip]
+    rows = []
+    for name in EXAMPLES:
+        if name not in opts.skip:
+            rows.append(_row(name, env, opts.generic))
+            print(rows[-1], file=sys.stderr, flush=True)
     builtin = min(_run(["solve", "case3"], env) for _ in range(3))
     frame = pd.DataFrame(rows)
     show("frameworks: CLI solve, end to end (s); cb.barriers of the solve (s)", frame,
-         {"first_solve_s": ".1f", "barriers_s": ".2f"})  # fmt: skip
+         {"first_solve_s": ".1f", "first_over_later": ".1f", "barriers_s": ".2f"})  # fmt: skip
     print(f"\nbuilt-in `solve case3` (same run, cached generic set): {builtin:.2f} s; "
           f"cotm.toml later solve / built-in: "
           f"{frame.set_index('example').loc['cotm', 'later_solve_s'] / builtin:.1f}x"

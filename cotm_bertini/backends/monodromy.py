@@ -317,7 +317,6 @@ def _bertini_paths(texts: tuple[str, str], points: np.ndarray, mptype: str, opti
         "codes": [_code(m) for m in meta],
         "finite": [bool(m.is_finite) for m in meta],
         "singular": [is_singular(m) for m in meta],
-        "times": [abs(complex(m.final_time_used)) for m in meta],
         "points": _end_points(solver.all_solutions(), points.shape[1]),
     }
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import same_sets
+from conftest import ROOT, same_sets
 from test_monodromy import ZFL, total_degree
 
 import cotm_bertini as cb
@@ -92,3 +92,22 @@ def test_an_interrupted_search_resumes_from_its_checkpoint(monkeypatch, tmp_path
     assert same_sets(resumed.points, whole.points)
     assert resumed.paths == whole.paths  # the same work, the first round not done twice
     assert np.isfinite(resumed.trace_residual)
+
+
+def test_the_cost_statement_follows_the_route(monkeypatch, tmp_path):
+    """By monodromy no time is promised (its path count is not known before the solve); by
+    total degree two seeds are counted, by "both" one plus the monodromy check."""
+    from cotm_bertini.model.framework import compiled
+
+    # An empty cache of its own (nothing solved yet), and of derived systems in memory too: the
+    # ones derived here must not outlive this cache for the tests after it.
+    monkeypatch.setenv("COTM_CACHE", str(tmp_path))
+    monkeypatch.setattr(compiled, "_LOADED", {})
+    fw = cb.Framework.from_toml(ROOT / "examples" / "zeeman.toml")
+    mono = cb.cost(fw, cb.Settings(generic="monodromy"), sample=False)
+    assert np.isnan(mono.estimate) and not mono.over_an_hour
+    assert "by monodromy" in mono.headline() and "estimated" not in mono.headline()
+    total = cb.cost(fw, cb.Settings(generic="total-degree"), sample=False)
+    both = cb.cost(fw, cb.Settings(generic="both"), sample=False)
+    assert total.paths == 2 * both.paths > 0 and np.isfinite(total.estimate)
+    assert both.headline().endswith("a monodromy set of the same seed to check it")

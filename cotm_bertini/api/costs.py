@@ -54,7 +54,8 @@ class Cost:
     rate_source: str
     measured: bool  # the rate was measured on sample paths (not a first guess)
     derive_seconds: float  # spent deriving equations to count the paths (cached from now on)
-    route: str = "total-degree"  # of the generic sets (backends.generic.route_of)
+    route: str = "total-degree"  # of the generic sets (backends.generic.route_of); "both":
+    # `sets` count the total-degree set of the seed, the monodromy one is not counted
 
     @property
     def paths(self) -> int:
@@ -108,10 +109,11 @@ class Cost:
             )
         from ..progress import duration
 
+        also = "; and a monodromy set of the same seed to check it" * (self.route == "both")
         return (
             f"{text}; {self.paths_to_solve} still to solve, an estimated "
             f"{duration(self.estimate)} at {self.seconds_per_path:.2g} s a path "
-            f"({self.rate_source})"
+            f"({self.rate_source}){also}"
         )
 
     def advice(self) -> str:
@@ -188,9 +190,9 @@ def cost(fw, settings: Settings | None = None, *, sample: bool | None = True) ->
 
     settings = settings or Settings()
     route = route_of(settings)
-    seeds = (
-        (settings.seed,) if route == "monodromy" else (settings.seed, settings.seed + SECOND_START)
-    )
+    # "both": the total-degree set of the seed itself is the one counted (and a monodromy set).
+    one = route in ("monodromy", "both")
+    seeds = (settings.seed,) if one else (settings.seed, settings.seed + SECOND_START)
     t0 = time.perf_counter()
     sets, systems = _sets(fw, seeds, route)
     derive_seconds = time.perf_counter() - t0

@@ -28,6 +28,7 @@ from .homotopy import (
     SECOND_START,
     START_CENTRE,
     GenericSet,
+    cached_generic,
     generic_key,
     generic_path,
     generic_set,
@@ -53,13 +54,10 @@ def monodromy_set(
     centre = START_CENTRE if centre is None else centre
     key = generic_key(ps, seed, centre, route=ROUTE)
     path = generic_path(key)
-    if use_cache and path.is_file():
-        try:
-            gs = replace(GenericSet.from_json(json.loads(path.read_text())), source="cache")
-            _LOADED[id(ps), seed] = gs
-            return gs
-        except (ValueError, KeyError):
-            path.unlink(missing_ok=True)  # a damaged cache entry is recomputed, not trusted
+    cached = cached_generic(path) if use_cache else None
+    if cached is not None:
+        _LOADED[id(ps), seed] = cached
+        return cached
     checkpoint = path.with_name(f"monodromy-{key}.partial.json") if use_cache else None
     with solver_errors(f"the monodromy generic set (seed {seed}, {len(ps.variables)} unknowns)"):
         found = monodromy_generic(ps, seed, centre, checkpoint=checkpoint)

@@ -214,16 +214,26 @@ def generic_set(
     return gs
 
 
+def cached_generic(path: Path) -> GenericSet | None:
+    """The generic set cached at `path` (source "cache"), or None: none there, or a damaged
+    entry (removed: it is recomputed, not trusted)."""
+    if not path.is_file():
+        return None
+    try:
+        return replace(GenericSet.from_json(json.loads(path.read_text())), source="cache")
+    except (ValueError, KeyError):
+        path.unlink(missing_ok=True)
+        return None
+
+
 def _load_or_solve(
     ps: ParametricSystem, seed: int, use_cache: bool, centre: dict, groups, scheduler=None
 ) -> GenericSet:
     key = generic_key(ps, seed, centre, groups)
     path = generic_path(key)
-    if use_cache and path.is_file():
-        try:
-            return replace(GenericSet.from_json(json.loads(path.read_text())), source="cache")
-        except (ValueError, KeyError):
-            path.unlink(missing_ok=True)  # a damaged cache entry is recomputed, not trusted
+    cached = cached_generic(path) if use_cache else None
+    if cached is not None:
+        return cached
     _announce(ps, seed, path if use_cache else None, groups, scheduler)
     what = f"the generic solution set (seed {seed}, {len(ps.variables)} unknowns)"
     with solver_errors(what):

@@ -9,7 +9,7 @@ import numpy as np
 
 from ..fs import cache_root
 from ..literals import bertini_number
-from ..model.polynomial import ParametricSystem, PolySystem
+from ..model.polynomial import ParametricSystem, PolySystem, Subfunctions
 from ..resources import template_texts
 from ..settings import Settings
 
@@ -92,6 +92,27 @@ def _functions(system: PolySystem) -> list[dict[str, str]]:
     ]
 
 
+def subfunction_lines(structured: Subfunctions | None) -> list[str]:
+    """The constants' declaration and values, then the subfunctions, as input-file lines (after
+    the `function` declaration, before the functions); none without a structure."""
+    if not structured:
+        return []
+    lines = []
+    if structured.constants:
+        lines.append(f"constant {', '.join(n for n, _ in structured.constants)};")
+        lines += [f"{n} = {complex_number(v)};" for n, v in structured.constants]
+    return lines + [f"{n} = {t};" for n, t in structured.definitions]
+
+
+def _structured_functions(system: PolySystem) -> list[dict[str, str]]:
+    """The functions as text: the structure's when the system has one, else the terms."""
+    if not system.structured:
+        return _functions(system)
+    return [
+        {"name": n, "text": t} for n, t in zip(system.names, system.structured.texts, strict=True)
+    ]
+
+
 def render_input(
     system: PolySystem, settings: Settings, params: dict[str, float], title: str = ""
 ) -> str:
@@ -111,11 +132,16 @@ def render_input(
 
 def render_system(system: PolySystem, groups: list[list[str]] | None = None) -> str:
     """A bare INPUT section (no CONFIG) for Bertini 2's in-process parser; complex allowed.
-    With `groups`, one variable_group each (Bertini then starts multihomogeneously)."""
+    With `groups`, one variable_group each (Bertini then starts multihomogeneously). A system
+    with subfunctions (PolySystem.structured) is written with them."""
     return (
         _environment()
         .get_template("system.input.j2")
-        .render(groups=groups or [list(system.variables)], functions=_functions(system))
+        .render(
+            groups=groups or [list(system.variables)],
+            functions=_structured_functions(system),
+            definitions=subfunction_lines(system.structured),
+        )
     )
 
 
@@ -142,7 +168,8 @@ def render_parameter_homotopy(
     """INPUT section of the homotopy moving the parameters from `start` (t=1) to `target` (t=0),
     on a straight line, or bulging into the complex plane by `detour` * t (1 - t), plus
     `twist` * t^2 (1 - t) for the parameters it names (their paths then loop, not go and come
-    back along one segment)."""
+    back along one segment). Without `texts`, a system with subfunctions (ps.structured) is
+    written with them."""
     twist = twist or {}
     parameters = [
         {
@@ -154,10 +181,17 @@ def render_parameter_homotopy(
         }
         for n in ps.parameters
     ]
-    texts = texts if texts is not None else parametric_texts(ps)
+    structured = ps.structured if texts is None else None
+    if texts is None:
+        texts = structured.texts if structured else parametric_texts(ps)
     functions = [{"name": n, "text": t} for n, t in zip(ps.names, texts, strict=True)]
     return (
         _environment()
         .get_template("parameter_homotopy.input.j2")
-        .render(variables=ps.variables, parameters=parameters, functions=functions)
+        .render(
+            variables=ps.variables,
+            parameters=parameters,
+            functions=functions,
+            definitions=subfunction_lines(structured),
+        )
     )

@@ -10,6 +10,19 @@ import numpy as np
 
 
 @dataclass(frozen=True)
+class Subfunctions:
+    """The same functions as Bertini text over named subexpressions (an input file's subfunction
+    lines), cheaper for Bertini to evaluate than the expanded terms (a fold condition's minors:
+    model/framework/folds.py): `definitions` (name, text) in order, each in the variables, the
+    parameters and the names defined before it; `texts` the functions; `constants` the
+    parameters at values (an instantiated system), written as Bertini constants."""
+
+    definitions: tuple[tuple[str, str], ...]
+    texts: tuple[str, ...]
+    constants: tuple[tuple[str, complex], ...] = ()
+
+
+@dataclass(frozen=True)
 class ParametricSystem:
     """Each function as terms coeff * x^var_exps * p^par_exps (p: the parameters, in order).
 
@@ -24,10 +37,11 @@ class ParametricSystem:
     par_exps: tuple[np.ndarray, ...]
     coeffs: tuple[np.ndarray, ...]
     texts: tuple[str, ...]
+    structured: Subfunctions | None = None  # rendered for Bertini in place of the terms
 
     def to_json(self) -> dict:
         """A JSON-able dict (see from_json)."""
-        return {
+        out = {
             "variables": list(self.variables),
             "names": list(self.names),
             "parameters": list(self.parameters),
@@ -36,6 +50,11 @@ class ParametricSystem:
             "coeffs": [c.tolist() for c in self.coeffs],
             "texts": list(self.texts),
         }
+        if self.structured:  # only then: the JSON (a cache key) of the others is unchanged
+            s = self.structured
+            out["structured"] = {"definitions": [list(d) for d in s.definitions],
+                                 "texts": list(s.texts)}  # fmt: skip
+        return out
 
     @classmethod
     def from_json(cls, data: dict) -> ParametricSystem:
@@ -49,7 +68,9 @@ class ParametricSystem:
             tuple(np.array(e, dtype=np.int64).reshape(len(e), npar) for e in data["par_exps"]),
             tuple(np.array(c, dtype=float) for c in data["coeffs"]),
             tuple(data["texts"]),
-        )
+            Subfunctions(tuple(tuple(d) for d in data["structured"]["definitions"]),
+                         tuple(data["structured"]["texts"])) if "structured" in data else None,
+        )  # fmt: skip
 
     def fix(self, values: dict[str, complex]) -> ParametricSystem:
         """The same system with the named parameters replaced by values (folded into the
@@ -109,7 +130,11 @@ class ParametricSystem:
             keep = total != 0
             exps.append(uniq[keep])
             cfs.append(total[keep])
-        return PolySystem(self.variables, self.names, tuple(exps), tuple(cfs))
+        structured = None
+        if self.structured:
+            constants = tuple(zip(self.parameters, p.tolist(), strict=True))
+            structured = Subfunctions(self.structured.definitions, self.structured.texts, constants)
+        return PolySystem(self.variables, self.names, tuple(exps), tuple(cfs), structured)
 
 
 @dataclass(frozen=True)
@@ -120,6 +145,7 @@ class PolySystem:
     names: tuple[str, ...]
     exponents: tuple[np.ndarray, ...]
     coefficients: tuple[np.ndarray, ...]
+    structured: Subfunctions | None = None  # rendered for Bertini in place of the terms
 
     @property
     def degrees(self) -> tuple[int, ...]:

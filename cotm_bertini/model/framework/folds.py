@@ -22,6 +22,8 @@ has over a thousand terms: generated scalar code took milliseconds a Jacobian); 
 system with (mx, my) = (x0, y0) + tline (dx, dy) on a
 line, tline unknown, whose parameters are the line's coefficients: solved once at a random
 complex line (a witness set of the curve), then reached on any real line by parameter homotopy.
+Bertini reads the fold condition as the minors of a larger matrix, in subfunctions (fold_matrix,
+_with_subfunctions): about 10 times cheaper to evaluate than its expanded terms.
 The file's other parameters enter as their values (_slot_values). Cached on disk by structure,
 map parameters, curve kind and those values, like compiled.py.
 """
@@ -30,7 +32,8 @@ from __future__ import annotations
 
 import hashlib
 import json
-from dataclasses import asdict, dataclass
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, replace
 from functools import cache
 from pathlib import Path
 
@@ -39,7 +42,7 @@ from sympy.polys.matrices import DomainMatrix
 
 from ...errors import ParameterError
 from ...fs import files_hash
-from ..polynomial import ParametricSystem, PolySystem
+from ..polynomial import ParametricSystem, PolySystem, Subfunctions
 from .compiled import cached_derivation, framework_system, variable_groups
 from .expressions import Expr
 from .spec import Framework
@@ -139,6 +142,51 @@ def _upper(m: int) -> list[tuple[int, int]]:
     return [(i, j) for i in range(m) for j in range(i, m)]
 
 
+def _bordered_hessian(fw: Framework, taut: tuple[str, ...]) -> tuple[sp.Matrix, list]:
+    """(B, springs): the bordered Hessian of the Lagrangian (fold_condition) with each spring's
+    alpha a symbol, and for each spring with L0 > 0 (alpha, v, k - w, d^2), its term in B
+    alpha v v^T (v zero on the constraints' rows)."""
+    from .derive import _active, local_frame
+
+    local, at, pos, cons, loads = local_frame(fw)
+    zfl, m = set(fw.zero_free_length()), len(local)
+    H = sp.zeros(m, m)
+    springs = []
+    for x in _active(fw, taut):
+        r = pos.of(x.a) - pos.of(x.b)
+        r0 = r.subs(at)
+        ri = [sp.diff(r, a).subs(at) for a in local]
+        k = sp.Symbol(f"k_{x.name}")
+        w = k if x.name in zfl else sp.Symbol(f"w_{x.name}")
+        if x.name not in zfl:
+            alpha, v = sp.Symbol(f"alpha_{x.name}"), [r0.dot(ri[i]) for i in range(m)]
+            springs.append((alpha, v + [0] * len(cons), k - w, sp.Symbol(f"d_{x.name}") ** 2))
+        for i, j in _upper(m):
+            term = w * (ri[i].dot(ri[j]) + r0.dot(sp.diff(r, local[i], local[j]).subs(at)))
+            if x.name not in zfl:
+                term += alpha * v[i] * v[j]
+            H[i, j] += term
+    L = -loads + sum(sp.Symbol(name) * g for g, name, _, _ in cons)
+    for i, j in _upper(m):
+        H[i, j] += sp.diff(L, local[i], local[j]).subs(at)
+        H[j, i] = H[i, j]
+    G = sp.Matrix([[sp.diff(g, a).subs(at) for a in local] for g, *_ in cons])
+    B = H if not len(cons) else sp.Matrix(sp.BlockMatrix([[H, G.T], [G, sp.zeros(len(cons))]]))
+    return B, springs
+
+
+def _exact(e: sp.Expr) -> sp.Expr:
+    """Every float of `e` as the rational it is: sums then cancel exactly (in floats the
+    determinant kept terms of 1e-19 that raised its degree, and so the path count, 1408 paths
+    instead of 1280 for cotm.toml's witness set)."""
+    return e.xreplace({f: sp.Rational(f) for f in e.atoms(sp.Float)})
+
+
+def _floats(e: sp.Expr) -> sp.Expr:
+    """The rational coefficients of a polynomial as floats (Bertini's text wants numbers)."""
+    return e.xreplace({q: sp.Float(q, 17) for q in e.atoms(sp.Rational) if not q.is_Integer})
+
+
 def fold_condition(fw: Framework, taut: tuple[str, ...], values: dict) -> sp.Expr:
     """A polynomial in the unknowns that vanishes where the bordered Hessian of the Lagrangian
     (local coordinates, constraints bordering it) is singular: a fold. `values`: every slot's
@@ -148,69 +196,119 @@ def fold_condition(fw: Framework, taut: tuple[str, ...], values: dict) -> sp.Exp
     alpha (r . r_i)(r . r_j) with w = k (1 - L0/d) and alpha = k L0 / d^3 = (k - w) / d^2. The
     determinant is affine in each alpha (each enters a rank-one term), so multiplying it by every
     d^2 clears the denominators: alpha -> k - w in a term that has it, else a factor d^2."""
-    from .derive import _active, local_frame
-
-    local, at, pos, cons, loads = local_frame(fw)
-    zfl, m = set(fw.zero_free_length()), len(local)
-    H = sp.zeros(m, m)
-    alphas, laws = [], []
-    for x in _active(fw, taut):
-        r = pos.of(x.a) - pos.of(x.b)
-        r0 = r.subs(at)
-        ri = [sp.diff(r, a).subs(at) for a in local]
-        k = sp.Symbol(f"k_{x.name}")
-        w = k if x.name in zfl else sp.Symbol(f"w_{x.name}")
-        if x.name not in zfl:
-            alpha = sp.Symbol(f"alpha_{x.name}")
-            alphas.append(alpha)
-            laws.append((k - w, sp.Symbol(f"d_{x.name}") ** 2))
-        for i, j in _upper(m):
-            term = w * (ri[i].dot(ri[j]) + r0.dot(sp.diff(r, local[i], local[j]).subs(at)))
-            if x.name not in zfl:
-                term += alpha * r0.dot(ri[i]) * r0.dot(ri[j])
-            H[i, j] += term
-    L = -loads + sum(sp.Symbol(name) * g for g, name, _, _ in cons)
-    for i, j in _upper(m):
-        H[i, j] += sp.diff(L, local[i], local[j]).subs(at)
-        H[j, i] = H[i, j]
-    G = sp.Matrix([[sp.diff(g, a).subs(at) for a in local] for g, *_ in cons])
-    B = H if not len(cons) else sp.Matrix(sp.BlockMatrix([[H, G.T], [G, sp.zeros(len(cons))]]))
+    B, springs = _bordered_hessian(fw, taut)
+    exact = {s: _exact(v) for s, v in values.items()}
     # Numbers first: the determinant's size grows with every symbol left in its entries.
-    B = B.applyfunc(lambda e: sp.expand(e.xreplace(values)))
+    B = B.applyfunc(lambda e: sp.expand(e.xreplace(exact)))
     # Over the polynomial ring, by minors (_det_by_minors): sympy's Matrix.det simplifies every
     # product and takes minutes on two bodies, and its Bareiss (dm.det()) divides exactly, which
     # with float coefficients (the four-bar's) did not finish in 14 CPU-minutes on a 5 x 5.
     dm = DomainMatrix.from_Matrix(B)
     det = sp.expand(dm.domain.to_sympy(_det_by_minors(dm)))
+    alphas = [a for a, *_ in springs]
     out = sp.Integer(0)
     for monomial, coeff in sp.Poly(det, *alphas).terms() if alphas else [((), det)]:
         factor = sp.Integer(1)
-        for e, (has, lacks) in zip(monomial, laws, strict=True):
-            factor *= (has if e else lacks).xreplace(values)
+        for e, (_, _, has, lacks) in zip(monomial, springs, strict=True):
+            factor *= (has if e else lacks).xreplace(exact)
         out += coeff * factor
-    return sp.expand(out)
+    return _floats(sp.expand(out))
 
 
-def _det_by_minors(dm: DomainMatrix):
-    """The determinant of a square DomainMatrix over a ring, division-free: Laplace expansion
-    along each row in turn, every minor of the bottom rows computed once (n 2^n products;
-    0.01 s for the four-bar's 5 x 5 bordered Hessian)."""
-    rows, zero = dm.rep.to_ddm(), dm.domain.zero
-    n = len(rows)
-    below = {0: dm.domain.one}  # column set (bitmask) -> minor of the bottom rows on it
+def fold_matrix(fw: Framework, taut: tuple[str, ...], values: dict) -> tuple[sp.Matrix, int]:
+    """(M, r): M = [[B0, V diag(k - w)], [V^T, -diag(d^2)]] (B0: the bordered Hessian without
+    its alpha terms, V: the r springs' v as columns, fold_condition's notation), whose
+    determinant is (-1)^r fold_condition without expanding it: by the Schur complement of the
+    lower right block, det M = (-1)^r prod d^2 det(B at alpha = (k - w) / d^2)."""
+    B, springs = _bordered_hessian(fw, taut)
+    n, r = B.shape[0], len(springs)
+    M = sp.zeros(n + r, n + r)
+    M[:n, :n] = B.xreplace({alpha: 0 for alpha, *_ in springs})
+    for s, (_, v, has, lacks) in enumerate(springs):
+        for i, vi in enumerate(v):
+            M[i, n + s], M[n + s, i] = vi * has, vi
+        M[n + s, n + s] = -lacks
+    exact = {s: _exact(v) for s, v in values.items()}
+    return M.applyfunc(lambda e: _floats(sp.expand(e.xreplace(exact)))), r
+
+
+def _laplace(n: int, entry: Callable, one, combine: Callable):
+    """The determinant of an n x n matrix, division-free: Laplace expansion along each row in
+    turn, every minor of the bottom rows computed once (n 2^n products). `entry(k, j)`: an
+    entry (None if zero); `combine(columns bitmask, [(sign, entry, minor)])`: that minor. None
+    if every expansion has a zero factor."""
+    below = {0: one}  # column set (bitmask) -> minor of the bottom rows on it
     for k in range(n - 1, -1, -1):
         above: dict = {}
         for cols, minor in below.items():
             for j in range(n):
-                if cols >> j & 1 or not rows[k][j]:
+                a = None if cols >> j & 1 else entry(k, j)
+                if a is None:
                     continue
-                term = rows[k][j] * minor
-                if bin(cols & ((1 << j) - 1)).count("1") % 2:
-                    term = -term
-                key = cols | 1 << j
-                above[key] = above.get(key, zero) + term
-        below = above
-    return below.get((1 << n) - 1, zero)
+                sign = -1 if bin(cols & ((1 << j) - 1)).count("1") % 2 else 1
+                above.setdefault(cols | 1 << j, []).append((sign, a, minor))
+        below = {cols: combine(cols, terms) for cols, terms in above.items()}
+    return below.get((1 << n) - 1)
+
+
+def _det_by_minors(dm: DomainMatrix):
+    """The determinant of a square DomainMatrix over a ring (_laplace; 0.01 s for the
+    four-bar's 5 x 5 bordered Hessian)."""
+    rows, ring = dm.rep.to_ddm(), dm.domain
+
+    def combine(_, terms):
+        out = ring.zero
+        for sign, a, minor in terms:
+            out = out + a * minor if sign > 0 else out - a * minor
+        return out
+
+    det = _laplace(len(rows), lambda k, j: rows[k][j] or None, ring.one, combine)
+    return ring.zero if det is None else det
+
+
+def _minors_program(M: sp.Matrix) -> tuple[list[tuple[str, str]], str | None]:
+    """det M as Bertini subfunctions: (name, text) of each nonzero entry, then of each minor of
+    the bottom rows (_laplace), and the name of the determinant (None if M is singular by its
+    zeros). Fixed-width numbers: Bertini 2's parser refuses a name that another one extends
+    (fold_m1 defined, then fold_m10)."""
+    from ..symbolic import bertini_text
+
+    n = M.shape[0]
+    wide, lines = len(str(n)), []
+    for i, j in ((i, j) for i in range(n) for j in range(n) if M[i, j] != 0):
+        lines.append((f"fold_b{i:0{wide}d}_{j:0{wide}d}", bertini_text(M[i, j])))
+    names = dict(lines)
+
+    def entry(k: int, j: int) -> str | None:
+        name = f"fold_b{k:0{wide}d}_{j:0{wide}d}"
+        return name if name in names else None
+
+    def combine(cols: int, terms: list) -> str:
+        text = " ".join(f"{'-' if s < 0 else '+'} {a}{'' if m is None else '*' + m}"
+                        for s, a, m in terms)  # fmt: skip
+        name = f"fold_m{cols:0{len(str(1 << n))}d}"
+        lines.append((name, text[2:] if text.startswith("+ ") else text))
+        return name
+
+    return lines, _laplace(n, entry, None, combine)
+
+
+def _with_subfunctions(ps: ParametricSystem, M: sp.Matrix, r: int, maps: dict):
+    """`ps` with its last function (the fold condition) written as (-1)^r det M by minors in
+    subfunctions (Bertini evaluates it 10 to 20 times faster than its 1,000 expanded terms:
+    bench/fold_eval.py), the map coordinates as subfunctions of the line (`maps`); `ps` as it
+    is if the subfunctions would name something it does not have."""
+    from ..symbolic import bertini_text
+
+    lines, top = _minors_program(M)
+    used = set().union(*(e.free_symbols for e in M))
+    defs = [(s.name, bertini_text(e)) for s, e in maps.items() if s in used]
+    named = {s.name for s in used - set(maps)}
+    named |= {s.name for s, e in maps.items() if s in used for s in e.free_symbols}
+    if top is None or not named <= {*ps.variables, *ps.parameters}:
+        return ps
+    texts = (*ps.texts[:-1], ("-" if r % 2 else "") + top)
+    return replace(ps, structured=Subfunctions(tuple(defs + lines), texts))
 
 
 def relaxed_applies(fw: Framework, taut: tuple[str, ...]) -> bool:
@@ -275,6 +373,8 @@ def _derive(fw: Framework, taut: tuple[str, ...], xname: str, yname: str, cable:
     try:
         ps = parametric_from_sympy((*names, t.name), labels, tuple(eqs), LINE)
         trace = parametric_from_sympy(tuple(z.name for z in Z), labels, tuple(G), ())
+        if not cable:
+            ps = _with_subfunctions(ps, *fold_matrix(fw, taut, values), line)
     except sp.PolynomialError as exc:
         raise ParameterError(
             f"{xname}, {yname}: a map parameter enters a number of framework {fw.name!r} "

@@ -63,7 +63,7 @@ class Settings:
     # the paths are tracked, not what is found: not part of a result's key).
     scheduler: str | None = None
     # How a generic set is found (backends/generic.py): "monodromy", "total-degree" or "both";
-    # None: backends.generic.DEFAULT_ROUTE (total-degree for now).
+    # None: backends.generic.DEFAULT_ROUTE (monodromy; total-degree with a scheduler).
     generic: str | None = None
 
     def __new__(cls, *args: object, **values: object) -> Settings:

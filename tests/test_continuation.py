@@ -45,7 +45,7 @@ def test_continued_point_equals_the_generic_route(step, method, newton, monkeypa
 def test_newton_starts_a_line_of_points_from_the_secant():
     """Points on a line: the third is started from the secant through the first two (closer
     than the second point's roots are), and what Newton finds from there is still checked."""
-    from cotm_bertini.backends.homotopy import generic_set
+    from cotm_bertini.backends.generic import generic_for
     from cotm_bertini.model.compiled import parametric_system
 
     a = solve_point(Params(L01=5.0))
@@ -58,7 +58,8 @@ def test_newton_starts_a_line_of_points_from_the_secant():
     assert np.abs(guess - mine).max() < np.abs(b.warm.points - mine).max()
     assert neighbour._secant(b.warm, Params(L01=5.1, k1=3.0)) is None  # off the line
     ps = parametric_system((False, True))
-    result, why = neighbour.newton_continue(ps, generic_set(ps, 1), b.warm, Params(L01=5.2))
+    gs = generic_for(ps, 1, Settings())  # the set the solves started from (default route)
+    result, why = neighbour.newton_continue(ps, gs, b.warm, Params(L01=5.2))
     assert why == "" and len(result[0]) == len(mine)
 
 
@@ -68,7 +69,7 @@ def test_newton_refuses_a_set_it_cannot_prove_complete():
     answer equals a fresh solve."""
     from dataclasses import replace
 
-    from cotm_bertini.backends.homotopy import generic_set
+    from cotm_bertini.backends.generic import generic_for
     from cotm_bertini.model.compiled import parametric_system
 
     a = solve_point(Params(L01=5.0))
@@ -76,7 +77,8 @@ def test_newton_refuses_a_set_it_cannot_prove_complete():
     points[1] = points[0]
     doubled = replace(a.warm, points=points)
     ps = parametric_system((False, True))
-    result, why = neighbour.newton_continue(ps, generic_set(ps, 1), doubled, Params(L01=5.05))
+    gs = generic_for(ps, 1, Settings())  # the set the solve started from (default route)
+    result, why = neighbour.newton_continue(ps, gs, doubled, Params(L01=5.05))
     assert result is None and why == "two starts converged to one root"
     b = solve_point(Params(L01=5.05), warm=doubled)
     assert b.details["homotopy"]["method"] != NEWTON

@@ -9,11 +9,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import ROOT, same_sets
+from conftest import ROOT, run_cli, same_sets
 from test_monodromy import ZFL, total_degree
 
 import cotm_bertini as cb
 from cotm_bertini.backends import generic, monodromy
+from cotm_bertini.backends.homotopy import SECOND_START
 from cotm_bertini.model.compiled import parametric_system
 
 
@@ -49,22 +50,50 @@ def test_both_routes_through_solve_agree_and_record_their_evidence():
     assert same_sets(gs.points, points)
 
 
-def test_a_failed_trace_test_makes_the_solve_incomplete(monkeypatch, tmp_path):
-    """A trace test that cannot pass (tolerance 0, stagnation after one fresh edge): the solve
-    still answers, its status is incomplete with the reason, and nothing is cached."""
+def _failing_search(monkeypatch, tmp_path) -> list:
+    """A trace test that cannot pass (tolerance 0, stagnation after one fresh edge), in an
+    empty cache of its own; the list counts the searches run."""
     monkeypatch.setenv("COTM_CACHE", str(tmp_path))
     monkeypatch.setattr(generic, "_LOADED", {})
-    real = generic.monodromy_generic
+    real, searches = generic.monodromy_generic, []
 
     def failing(*args, **kw):
+        searches.append(1)
         return real(*args, **{**kw, "trace_tol": 0.0, "max_stall": 1})
 
     monkeypatch.setattr(generic, "monodromy_generic", failing)
+    return searches
+
+
+def test_a_failed_trace_test_makes_the_solve_incomplete(monkeypatch, tmp_path):
+    """generic='monodromy' and a failed trace test: the solve still answers, its status is
+    incomplete with the reason; the set is cached as incomplete, so a second solve (a sweep's
+    next point) says the same without searching again."""
+    searches = _failing_search(monkeypatch, tmp_path)
     settings = cb.Settings(seed=5, generic="monodromy")
-    res = cb.solve(cb.Params.case("case1"), settings=settings, cache=False)
-    assert res.status == "incomplete"
-    assert any("stagnation" in w and "trace test" in w for w in res.warnings), res.warnings
-    assert not list(tmp_path.glob("generic-*.json"))
+    for _ in range(2):
+        res = cb.solve(cb.Params.case("case1"), settings=settings, cache=False)
+        assert res.status == "incomplete"
+        assert any("stagnation" in w and "trace test" in w for w in res.warnings), res.warnings
+    assert len(searches) == 1
+    monkeypatch.setattr(generic, "_LOADED", {})  # from the disk cache too
+    again = cb.solve(cb.Params.case("case1"), settings=settings, cache=False)
+    assert again.status == "incomplete" and len(searches) == 1
+
+
+def test_the_default_route_falls_back_to_total_degree_after_a_failed_trace_test(
+    monkeypatch, tmp_path
+):
+    """The default route (generic unset) after a failed trace test: the total-degree route's
+    two sets, whose counts agree, so the solve is complete (the paper's 6 equilibria of case
+    1, Table 2), and run.json says why the monodromy set was not used."""
+    searches = _failing_search(monkeypatch, tmp_path)
+    res = cb.solve(cb.Params.case("case1"), settings=cb.Settings(seed=5), cache=False)
+    assert len(searches) == 1 and res.status == "ok", res.warnings
+    first, second = res.record["details"]["homotopy"]["generic_route"]["generic_sets"]
+    assert "stagnation" in first["after_monodromy"] and "after_monodromy" not in second
+    assert (first["seed"], second["seed"]) == (5, 5 + SECOND_START)
+    assert len(res.table) == 6
 
 
 def test_an_interrupted_search_resumes_from_its_checkpoint(monkeypatch, tmp_path):
@@ -111,3 +140,18 @@ def test_the_cost_statement_follows_the_route(monkeypatch, tmp_path):
     both = cb.cost(fw, cb.Settings(generic="both"), sample=False)
     assert total.paths == 2 * both.paths > 0 and np.isfinite(total.estimate)
     assert both.headline().endswith("a monodromy set of the same seed to check it")
+
+
+def test_params_takes_the_seed_and_route_of_the_first_solve(tmp_path):
+    """`params --framework` states the work of the seed and route asked for; for the paper's
+    mechanism (no cost statement) they are refused in one line, not ignored."""
+    env = {"COTM_CACHE": str(tmp_path)}
+    zeeman = str(ROOT / "examples" / "zeeman.toml")
+    mono = run_cli("params", "--framework", zeeman, "--seed", "3", env=env)
+    assert mono.returncode == 0, mono.stderr
+    assert "first solve of zeeman (seed 3)" in mono.stdout and "by monodromy" in mono.stdout
+    total = run_cli("params", "--framework", zeeman, "--generic", "total-degree", env=env)
+    assert "x 2 seeds" in total.stdout and "by monodromy" not in total.stdout
+    refused = run_cli("params", "case3", "--seed", "3", env=env)
+    assert refused.returncode == 2 and refused.stdout == ""
+    assert "--seed: only with --framework" in refused.stderr

@@ -225,7 +225,8 @@ def test_6_first_generic_solve_says_what_once_and_shows_progress(tmp_path):
     """A new seed: one line on stderr (what, once, roughly how long), then a progress bar on a
     terminal; the same seed again (solved anew): no such line."""
     env = {"COTM_CACHE": str(tmp_path / "cache")}
-    args = ["solve", "case2", "--seed", "4242", "--no-plots", "--quiet", "--out", str(tmp_path)]
+    args = ["solve", "case2", "--seed", "4242", "--generic", "total-degree", "--no-plots",
+            "--quiet", "--out", str(tmp_path)]  # fmt: skip
     shown = _in_a_terminal(args, env)
     lines = [ln for ln in shown.splitlines() if ANNOUNCE in ln]
     assert len(lines) == 1, shown

@@ -108,6 +108,43 @@ def test_monodromy_equals_multihomogeneous_on_the_double_pendulum():
     assert_same_as_total_degree("double_pendulum")
 
 
+def _example_sets() -> list[tuple[str, tuple[str, ...]]]:
+    """(example, taut set) of every shipped example's taut sets with isolated equilibria, but
+    chain3's (86,528 paths a set by Bertini's own solve: docs/benchmarks.md)."""
+    from cotm_bertini.model.framework.compiled import framework_system
+    from cotm_bertini.point import taut_sets
+
+    out = []
+    for path in sorted((ROOT / "examples").glob("*.toml")):
+        if path.stem == "chain3":
+            continue
+        fw = cb.Framework.from_toml(path)
+        out += [(path.stem, t) for t in taut_sets(fw) if not framework_system(fw, t).free]
+    return out
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "name, taut",
+    [pytest.param(n, t, id=f"{n}-{'+'.join(t) or 'none-taut'}") for n, t in _example_sets()],
+)
+def test_every_taut_set_of_every_example_by_monodromy_equals_bertinis_own_solve(name, taut):
+    """The default route against Bertini's own multihomogeneous solve (ZeroDimSolver called
+    here, not the package's total-degree route): the same finite nonsingular set to 1e-8."""
+    from cotm_bertini.model.framework.compiled import framework_system, variable_groups
+    from cotm_bertini.model.framework.units import normalized_slots
+
+    fw = cb.Framework.from_toml(ROOT / "examples" / f"{name}.toml")
+    fs = framework_system(fw, taut)
+    centre = normalized_slots(fw.at_defaults())
+    m = mono.monodromy_generic(fs.ps, SEED, {n: centre[n] for n in fs.ps.parameters})
+    assert m.complete and m.trace_residual < mono.TRACE_TOL, m.reason
+    system = fs.ps.instantiate([m.start[n] for n in fs.ps.parameters])
+    points, finite, singular = total_degree(system, variable_groups(fs))
+    assert same_sets(m.points, points), (len(m.points), len(points))
+    assert (m.finite_endpoints, m.singular_endpoints) == (finite, singular)
+
+
 def test_augmented_fibre_is_complete_and_a_dropped_root_fails_the_trace_test():
     """The monodromy's augmented fibre is the whole fibre of G(x; c0, e0) (Bertini's
     total-degree solve of G itself); its trace is affine; without any one root it is not."""

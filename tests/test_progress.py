@@ -60,8 +60,8 @@ def test_first_solve_reports_measured_rate_and_the_cost_first(tmp_path):
     taken from the first set's measured rate. Afterwards `params` says both sets are cached."""
     env = {"COTM_CACHE": str(tmp_path / "cache"), progress.ENV_SECONDS: "0",
            progress.ENV_DELAY: "0"}  # fmt: skip
-    res = run_cli("solve", "--framework", str(ZEEMAN), "--no-plots", "--quiet",
-                  "--out", str(tmp_path / "runs"), env=env)  # fmt: skip
+    res = run_cli("solve", "--framework", str(ZEEMAN), "--no-plots", "--quiet", "--generic",
+                  "total-degree", "--out", str(tmp_path / "runs"), env=env)  # fmt: skip
     assert res.returncode == 0, res.stderr
     assert "\r" not in res.stderr  # lines, no bar
     paths = zeeman_paths()
@@ -84,7 +84,7 @@ def test_first_solve_reports_measured_rate_and_the_cost_first(tmp_path):
     # Announced when its first guess (the first set's measured rate) is over 2 s.
     for line in [ln for ln in lines if "solving the generic solution set" in ln]:
         assert "first guess" in line and ("seed 1 " in line or "seed 1's paths" in line)
-    again = run_cli("params", "--framework", str(ZEEMAN), env=env)
+    again = run_cli("params", "--framework", str(ZEEMAN), "--generic", "total-degree", env=env)
     assert again.returncode == 0, again.stderr
     assert "(seeds 1, 7920 cached)" in again.stdout
     assert "every generic set is in the cache already" in again.stdout
@@ -95,7 +95,7 @@ def test_params_framework_states_paths_seeds_and_a_measured_estimate(tmp_path):
     with each taut set's unknowns and paths (the Bezout number, counted here), the two seeds,
     and an estimate from paths measured now, said to be an estimate."""
     env = {"COTM_CACHE": str(tmp_path / "cache")}
-    res = run_cli("params", "--framework", str(ZEEMAN), env=env)
+    res = run_cli("params", "--framework", str(ZEEMAN), "--generic", "total-degree", env=env)
     assert res.returncode == 0, res.stderr
     assert tomllib.loads(res.stdout) == {"x": 0.0, "y": 0.0}
     paths = zeeman_paths()
@@ -120,7 +120,7 @@ def test_cost_beyond_an_hour_says_so_and_what_to_do(tmp_path, monkeypatch):
     from cotm_bertini.api.costs import cost
 
     monkeypatch.setenv("COTM_CACHE", str(tmp_path))
-    c = cost(cb.Framework.from_toml(ZEEMAN), sample=False)
+    c = cost(cb.Framework.from_toml(ZEEMAN), cb.Settings(generic="total-degree"), sample=False)
     assert c.paths == c.paths_to_solve == 2 * zeeman_paths() and not c.measured
     assert "first guess" in c.headline() and not c.advice()
     slow = replace(c, seconds_per_path=3600.0 / c.paths_to_solve * 1.5)

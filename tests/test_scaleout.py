@@ -223,7 +223,9 @@ def test_solve_with_scheduler_equals_solve_without(scheduler, tmp_path, monkeypa
     path.write_text(TINY_CHAIN)
     fw = cb.Framework.from_toml(path)  # two bodies: the split route on a torus framework
     solved = {}
-    for name, options in (("split", {"scheduler": scheduler}), ("bertini", {})):
+    # Without a scheduler the total-degree route asked for: the one a scheduler splits.
+    plain_route = {"settings": cb.Settings(generic="total-degree")}
+    for name, options in (("split", {"scheduler": scheduler}), ("bertini", plain_route)):
         monkeypatch.setenv("COTM_CACHE", str(tmp_path / name))  # generic sets solved afresh
         monkeypatch.setattr(homotopy, "_LOADED", {})
         solved[name] = cb.solve(fw, cache=False, **options)

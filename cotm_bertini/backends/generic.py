@@ -10,8 +10,9 @@ random complex start parameters, homotopy.generic_start):
   a second set from an independent start (seed + SECOND_START) with the same count.
 
 `Settings.generic` chooses: "monodromy", "total-degree", or "both" (the monodromy set, checked
-against the total-degree set of the same seed); unset, DEFAULT_ROUTE (total-degree for now:
-monodromy becomes the default once every shipped example's first solve is measured on it).
+against the total-degree set of the same seed); unset, DEFAULT_ROUTE, monodromy (one set and
+its proof instead of two sets, and a cost that follows the solutions: docs/benchmarks.md), or
+total-degree with a Dask scheduler (which splits that route's paths over its workers).
 Both routes' sets are cached apart (the key names the route), so each is solved once.
 """
 
@@ -47,8 +48,9 @@ def monodromy_set(
 ) -> GenericSet:
     """The generic set of `ps` for `seed` by monodromy: from memory, the cache, or found (its
     working state checkpointed next to the cache entry, so an interrupted search resumes). An
-    incomplete set (the trace test failed) comes back with route["complete"] False, is never
-    cached, and whoever uses it reports it (status incomplete)."""
+    incomplete set (the trace test failed) comes back with route["complete"] False, and whoever
+    uses it reports it (status incomplete) or falls back (evidence_sets); it is cached as such,
+    so that a sweep's points and workers do not run the failing search again."""
     if use_cache and (id(ps), seed) in _LOADED:
         return replace(_LOADED[id(ps), seed], source="memory")
     centre = START_CENTRE if centre is None else centre
@@ -65,13 +67,15 @@ def monodromy_set(
     if not found.complete:
         say(f"cotm-bertini: warning: the monodromy generic set (seed {seed}) is incomplete: "
             f"{found.reason}")  # fmt: skip
-    elif use_cache:
+    if use_cache:
         atomic_write_text(path, json.dumps(gs.to_json()))
         _LOADED[id(ps), seed] = gs
+        if checkpoint is not None:
+            checkpoint.unlink(missing_ok=True)  # finished, complete or not: nothing to resume
     return gs
 
 
-DEFAULT_ROUTE = "total-degree"  # until the examples' first solves are measured on monodromy
+DEFAULT_ROUTE = "monodromy"
 
 
 def route_of(settings: Settings) -> str:
@@ -107,11 +111,32 @@ def evidence_sets(
     total-degree set of the same seed (the same count, two routes)."""
     route, seed = route_of(settings), settings.seed
     first = generic_for(ps, seed, settings, centre, groups)
+    if route == "monodromy" and failed(first) and settings.generic is None:
+        return _fallback(ps, settings, centre, groups, first)
     if route == "monodromy":
         return (first,)
     other = seed + SECOND_START if route == "total-degree" else seed
     second = generic_set(ps, other, centre=centre, groups=groups, scheduler=settings.scheduler)
     return first, second
+
+
+def failed(gs: GenericSet) -> bool:
+    """Whether a generic set is one whose route says it is incomplete (a failed trace test)."""
+    return gs.route.get("complete") is False
+
+
+def _fallback(ps, settings: Settings, centre, groups, failed_set: GenericSet) -> tuple:
+    """The default route after a failed trace test: the total-degree route's two sets (their
+    counts the evidence), the first recording why the monodromy set was not used. An explicit
+    generic='monodromy' does not fall back: its incomplete set is reported as such."""
+    reason = failed_set.route.get("reason", "no reason recorded")
+    if failed_set.source == "solved":  # once, not at every point of a sweep (run.json says it)
+        say(f"cotm-bertini: the monodromy generic set (seed {settings.seed}) failed its trace "
+            "test; the default route falls back to the total-degree route (two seeds)")  # fmt: skip
+    sets = [generic_set(ps, s, centre=centre, groups=groups)
+            for s in (settings.seed, settings.seed + SECOND_START)]  # fmt: skip
+    note = {"after_monodromy": f"the monodromy set was incomplete ({reason})"}
+    return (replace(sets[0], route={**sets[0].route, **note}), sets[1])
 
 
 def disagreements(sets) -> list[str]:

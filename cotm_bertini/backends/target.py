@@ -56,9 +56,13 @@ def solve_target(
     user's units; the spring lengths are scaled back.
     """
     deadline = None if settings.timeout is None else time.perf_counter() + settings.timeout
-    gs = generic_for(ps, settings.seed, settings)
-    # "both": the total-degree set of the same seed too, its count the cross-check.
-    sets = evidence_sets(ps, settings) if route_of(settings) == "both" else (gs,)
+    # "both": the total-degree set of the same seed too, its count the cross-check; the
+    # default route: the total-degree sets when the monodromy one failed its trace test.
+    if route_of(settings) == "total-degree":
+        sets = (generic_for(ps, settings.seed, settings),)
+    else:
+        sets = evidence_sets(ps, settings)
+    gs = sets[0]
     unit = params.normalized()
     result, note = None, ""
     if warm is not None:

@@ -269,9 +269,12 @@ def params(args: argparse.Namespace) -> int:
 
         for name, value in p.as_dict().items():
             print(f"{name} = {value!r}")
-        for line in cost(p).lines():  # TOML comments: the output is still a parameter file
+        for line in cost(p, settings_from(args)).lines():  # TOML comments: still a TOML file
             print(line)
         return EXIT_OK
+    given = [f"--{n}" for n in ("seed", "generic") if getattr(args, n, None) is not None]
+    if given:  # they decide a framework's cost statement; the paper's mechanism prints none
+        raise ParameterError(f"{', '.join(given)}: only with --framework (a first solve's work)")
     for name, value in p.as_dict().items():
         print(f"{name} = {value!r}  # {PARAM_UNITS[name]}, {PARAM_MEANING[name]}")
     return EXIT_OK

@@ -14,6 +14,7 @@ from .options import (
     Parser,
     add_case,
     add_params,
+    add_route,
     add_settings,
 )
 
@@ -190,6 +191,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     add_case(pr)
     add_params(pr)
+    add_route(pr)
     pr.set_defaults(run=commands.params)
     return ap
 

@@ -73,9 +73,22 @@ def add_params(p: argparse.ArgumentParser) -> None:
     )
 
 
+def add_route(p: argparse.ArgumentParser) -> None:
+    """The seed and the generic-set route (also `params`: they decide a first solve's work)."""
+    p.add_argument("--seed", type=int, help="random seed of the solver (default 1)")
+    p.add_argument(
+        "--generic",
+        choices=("monodromy", "total-degree", "both"),
+        help="how a generic solution set is found: monodromy, trace-tested (default; after "
+        "a failed trace test the default falls back to total-degree); Bertini's total-degree "
+        "start, two seeds agree (the route with --scheduler); or both (the monodromy set "
+        "checked against the total-degree one)",
+    )
+
+
 def add_settings(p: argparse.ArgumentParser) -> None:
     """The solver settings every solving subcommand accepts (all honoured or refused)."""
-    p.add_argument("--seed", type=int, help="random seed of the solver (default 1)")
+    add_route(p)
     p.add_argument(
         "--engine",
         choices=("homotopy", "cli"),
@@ -94,13 +107,6 @@ def add_settings(p: argparse.ArgumentParser) -> None:
         help="seconds before the solve is stopped (default: 600 for cli, none in-process)",
     )
     p.add_argument("--threads", type=int, help="solver threads (default: every core)")
-    p.add_argument(
-        "--generic",
-        choices=("monodromy", "total-degree", "both"),
-        help="how a generic solution set is found: monodromy, trace-tested; Bertini's "
-        "total-degree start, two seeds agree (default, for now); or both (the monodromy set "
-        "checked against the total-degree one)",
-    )
     p.add_argument(
         "--bertini",
         metavar="PATH",

@@ -261,6 +261,8 @@ FRAMEWORK_COUNTS = {
     "real, physical, stable, singular": "rows that are so",
     "taut_sets_solved": "taut sets solved (cables always taut or never taut are not enumerated)",
     "taut_sets_continuum": "taut sets where something moves freely (see details.taut_sets)",
+    "taut_sets_pruned": "taut sets no pose can hold, not solved (bound smoothing; the proof "
+    "in details.taut_sets)",
     "closed_form_endpoints": "0: a framework has no closed-form roots",
 }
 

@@ -219,6 +219,9 @@ def solve_framework_point(
     unit = units(fw)
     target, centre = normalized_slots(fw), normalized_slots(fw.at_defaults())
     parts, report, texts, starts = [], {}, [], {}
+    for taut, why in pruned_taut_sets(fw).items():  # not solved: no consistent equilibrium
+        report[" ".join(taut) or "none"] = {"excluded": True, "pruned": "bound smoothing",
+                                           "note": why.note()}  # fmt: skip
     for taut in taut_sets(fw):
         part, info, text = _solve_taut_set(
             fw, taut, unit, target, centre, settings, tolerances, t, (warm or {}, starts)
@@ -244,7 +247,23 @@ def solve_framework_point(
 def taut_sets(fw) -> list[tuple[str, ...]]:
     """The subsets of the cables that can be taut together (all taut first), each its own
     polynomial system: a cable longer than its free length in every pose is in all of them, one
-    never longer in none (model.framework.reach bounds the lengths over every pose)."""
+    never longer in none (model.framework.reach bounds the lengths over every pose), and a set
+    no pose can hold is left out (pruned_taut_sets says which and why)."""
+    pruned = pruned_taut_sets(fw)
+    return [t for t in _cable_subsets(fw) if t not in pruned]
+
+
+def pruned_taut_sets(fw) -> dict:
+    """The taut sets no pose can hold (model.framework.prune: bound smoothing), each with its
+    proof (a prune.Pruned)."""
+    from .model.framework.prune import prune
+
+    found = {t: prune(fw, t) for t in _cable_subsets(fw)}
+    return {t: p for t, p in found.items() if p is not None}
+
+
+def _cable_subsets(fw) -> list[tuple[str, ...]]:
+    """Every subset of the cables reach.cable_states leaves open, with the always-taut ones."""
     from itertools import combinations
 
     from .model.framework.reach import cable_states

@@ -78,7 +78,10 @@ def framework_counts(table: dict, report: dict) -> dict:
         "stable": int(np.sum(table["stable"])),
         "singular": int(np.sum(table["singular"])),
         "taut_sets_solved": len(solved),
-        "taut_sets_continuum": len(report) - len(solved),
+        "taut_sets_continuum": sum(
+            "tracked" not in r and "pruned" not in r for r in report.values()
+        ),
+        "taut_sets_pruned": sum("pruned" in r for r in report.values()),
     }
 
 

@@ -56,6 +56,7 @@ class Cost:
     derive_seconds: float  # spent deriving equations to count the paths (cached from now on)
     route: str = "total-degree"  # of the generic sets (backends.generic.route_of); "both":
     # `sets` count the total-degree set of the seed, the monodromy one is not counted
+    pruned: int = 0  # taut sets no pose can hold (point.pruned_taut_sets): not in `sets`
 
     @property
     def paths(self) -> int:
@@ -93,7 +94,7 @@ class Cost:
         per = per or "0"
         free = len(self.sets) - len(solved)
         text = (
-            f"{self.name}: {len(self.sets)} taut set{'s' * (len(self.sets) != 1)}"
+            f"{self._taut_sets()}"
             + (f" ({free} moving freely, not solved)" if free else "")
             + f", {per} paths per generic set x {len(self.seeds)} seeds = {self.paths} paths"
         )
@@ -102,7 +103,7 @@ class Cost:
         if self.route == "monodromy":
             todo = sum(len(self.seeds) - len(s.cached) for s in solved)
             return (
-                f"{self.name}: {len(self.sets)} taut set{'s' * (len(self.sets) != 1)}, "
+                f"{self._taut_sets()}, "
                 f"{todo} generic set{'s' * (todo != 1)} to find by monodromy (its paths follow "
                 f"the number of solutions, not known before; the total-degree route would "
                 f"track {per} paths per set): the progress lines measure the rate"
@@ -115,6 +116,12 @@ class Cost:
             f"{duration(self.estimate)} at {self.seconds_per_path:.2g} s a path "
             f"({self.rate_source}){also}"
         )
+
+    def _taut_sets(self) -> str:
+        """The name and the taut sets counted (and those pruned, if any)."""
+        n = len(self.sets)
+        pruned = f" ({self.pruned} more pruned: no pose holds them)" if self.pruned else ""
+        return f"{self.name}: {n} taut set{'s' * (n != 1)}{pruned}"
 
     def advice(self) -> str:
         """What to do about an estimate beyond an hour (empty otherwise)."""
@@ -212,7 +219,10 @@ def cost(fw, settings: Settings | None = None, *, sample: bool | None = True) ->
         )
         remember(ps, groups, rate, source)
         measured = True
-    return Cost(fw.name, tuple(sets), seeds, rate, source, measured, derive_seconds, route)
+    from ..point import pruned_taut_sets
+
+    pruned = len(pruned_taut_sets(fw))
+    return Cost(fw.name, tuple(sets), seeds, rate, source, measured, derive_seconds, route, pruned)
 
 
 def _sets(fw, seeds: tuple[int, ...], route: str) -> tuple[list[SetCost], list[tuple]]:

@@ -219,10 +219,11 @@ def solve_framework_point(
     unit = units(fw)
     target, centre = normalized_slots(fw), normalized_slots(fw.at_defaults())
     parts, report, texts, starts = [], {}, [], {}
-    for taut, why in pruned_taut_sets(fw).items():  # not solved: no consistent equilibrium
+    sets, pruned = split_taut_sets(fw)
+    for taut, why in pruned.items():  # not solved: no consistent equilibrium
         report[" ".join(taut) or "none"] = {"excluded": True, "pruned": "bound smoothing",
                                            "note": why.note()}  # fmt: skip
-    for taut in taut_sets(fw):
+    for taut in sets:
         part, info, text = _solve_taut_set(
             fw, taut, unit, target, centre, settings, tolerances, t, (warm or {}, starts)
         )
@@ -249,17 +250,23 @@ def taut_sets(fw) -> list[tuple[str, ...]]:
     polynomial system: a cable longer than its free length in every pose is in all of them, one
     never longer in none (model.framework.reach bounds the lengths over every pose), and a set
     no pose can hold is left out (pruned_taut_sets says which and why)."""
-    pruned = pruned_taut_sets(fw)
-    return [t for t in _cable_subsets(fw) if t not in pruned]
+    return split_taut_sets(fw)[0]
 
 
 def pruned_taut_sets(fw) -> dict:
     """The taut sets no pose can hold (model.framework.prune: bound smoothing), each with its
     proof (a prune.Pruned)."""
+    return split_taut_sets(fw)[1]
+
+
+def split_taut_sets(fw) -> tuple[list[tuple[str, ...]], dict]:
+    """(taut_sets, pruned_taut_sets) from one pass of the pruning."""
     from .model.framework.prune import prune
 
     found = {t: prune(fw, t) for t in _cable_subsets(fw)}
-    return {t: p for t, p in found.items() if p is not None}
+    return [t for t, p in found.items() if p is None], {
+        t: p for t, p in found.items() if p is not None
+    }
 
 
 def _cable_subsets(fw) -> list[tuple[str, ...]]:

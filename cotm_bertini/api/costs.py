@@ -201,7 +201,7 @@ def cost(fw, settings: Settings | None = None, *, sample: bool | None = True) ->
     one = route in ("monodromy", "both")
     seeds = (settings.seed,) if one else (settings.seed, settings.seed + SECOND_START)
     t0 = time.perf_counter()
-    sets, systems = _sets(fw, seeds, route)
+    sets, systems, pruned = _sets(fw, seeds, route)
     derive_seconds = time.perf_counter() - t0
     todo = [k for k, s in enumerate(sets) if not s.free and len(s.cached) < len(seeds)]
     big = max(todo, key=lambda k: sets[k].paths) if todo else None
@@ -219,23 +219,20 @@ def cost(fw, settings: Settings | None = None, *, sample: bool | None = True) ->
         )
         remember(ps, groups, rate, source)
         measured = True
-    from ..point import pruned_taut_sets
-
-    pruned = len(pruned_taut_sets(fw))
     return Cost(fw.name, tuple(sets), seeds, rate, source, measured, derive_seconds, route, pruned)
 
 
-def _sets(fw, seeds: tuple[int, ...], route: str) -> tuple[list[SetCost], list[tuple]]:
+def _sets(fw, seeds: tuple[int, ...], route: str) -> tuple[list[SetCost], list[tuple], int]:
     """Each taut set's SetCost and (system, groups, centre) of its generic solves, derived in
-    order with "taut set k/n" in the derivation's progress lines."""
+    order with "taut set k/n" in the derivation's progress lines; and how many were pruned."""
     from ..backends.homotopy import generic_path
     from ..backends.path_progress import path_count
     from ..model.framework.compiled import framework_system, variable_groups
     from ..model.framework.units import normalized_slots
-    from ..point import taut_sets
+    from ..point import split_taut_sets
 
     slots = normalized_slots(fw.at_defaults())  # the generic sets' centre, as a solve has it
-    tauts = taut_sets(fw)
+    tauts, pruned = split_taut_sets(fw)
     sets, systems = [], []
     for k, taut in enumerate(tauts):
         fs = framework_system(fw, taut, label=f"taut set {k + 1}/{len(tauts)}")
@@ -249,7 +246,7 @@ def _sets(fw, seeds: tuple[int, ...], route: str) -> tuple[list[SetCost], list[t
         paths = 0 if free else path_count(fs.ps, groups)
         sets.append(SetCost(taut, len(fs.ps.variables), len(groups), paths, free, cached))
         systems.append((fs.ps, groups, centre))
-    return sets, systems
+    return sets, systems, len(pruned)
 
 
 def _key(ps, seed: int, centre: dict, groups, route: str) -> str:

@@ -104,13 +104,12 @@ def subfunction_lines(structured: Subfunctions | None) -> list[str]:
     return lines + [f"{n} = {t};" for n, t in structured.definitions]
 
 
-def _structured_functions(system: PolySystem) -> list[dict[str, str]]:
-    """The functions as text: the structure's when the system has one, else the terms."""
-    if not system.structured:
-        return _functions(system)
-    return [
-        {"name": n, "text": t} for n, t in zip(system.names, system.structured.texts, strict=True)
-    ]
+def function_texts(system: PolySystem) -> list[str]:
+    """Each function as Bertini text: over the system's subfunctions when it has them (write
+    subfunction_lines before them), else its terms."""
+    if system.structured:
+        return list(system.structured.texts)
+    return [f["text"] for f in _functions(system)]
 
 
 def render_input(
@@ -139,7 +138,10 @@ def render_system(system: PolySystem, groups: list[list[str]] | None = None) -> 
         .get_template("system.input.j2")
         .render(
             groups=groups or [list(system.variables)],
-            functions=_structured_functions(system),
+            functions=[
+                {"name": n, "text": t}
+                for n, t in zip(system.names, function_texts(system), strict=True)
+            ],
             definitions=subfunction_lines(system.structured),
         )
     )

@@ -18,7 +18,7 @@ from itertools import islice, product
 import numpy as np
 
 from ..model.polynomial import PolySystem
-from .render import complex_number, polynomial_text, subfunction_lines
+from .render import complex_number, function_texts, subfunction_lines
 
 
 @dataclass(frozen=True)
@@ -136,10 +136,7 @@ def linear_product_start(
 def gamma_homotopy_text(system: PolySystem, start: LinearProductStart, gamma: complex) -> str:
     """INPUT section of H = (1 - t) F + gamma t G (F: `system`, with its subfunctions if it has
     them, G: `start`), one affine group."""
-    funcs = list(system.structured.texts) if system.structured else [
-        polynomial_text(system.variables, e, c)
-        for e, c in zip(system.exponents, system.coefficients, strict=True)
-    ]  # fmt: skip
+    funcs = function_texts(system)
     lines = [
         "INPUT",
         f"variable_group {', '.join(system.variables)};",

@@ -304,7 +304,7 @@ def _with_subfunctions(ps: ParametricSystem, M: sp.Matrix, r: int, maps: dict):
     used = set().union(*(e.free_symbols for e in M))
     defs = [(s.name, bertini_text(e)) for s, e in maps.items() if s in used]
     named = {s.name for s in used - set(maps)}
-    named |= {s.name for s, e in maps.items() if s in used for s in e.free_symbols}
+    named |= {x.name for s, e in maps.items() if s in used for x in e.free_symbols}
     if top is None or not named <= {*ps.variables, *ps.parameters}:
         return ps
     texts = (*ps.texts[:-1], ("-" if r % 2 else "") + top)

@@ -129,3 +129,28 @@ def test_the_cost_statement_counts_the_pruned_sets_apart(tmp_path, monkeypatch):
     c = cb.cost(_series(tmp_path), sample=False)
     assert len(c.sets) == 3 and c.pruned == 1
     assert "3 taut sets (1 more pruned: no pose holds them)" in c.headline()
+
+
+def test_a_set_too_large_to_lay_out_is_not_sampled(tmp_path, monkeypatch):
+    """cb.cost samples the rate on the largest set of at most SAMPLE_MAX_PATHS paths (Bertini
+    lays out every start point first: prism_slack's smallest set spent 56 s there); with every
+    set above the cap nothing is sampled, and the statement says why."""
+    from cotm_bertini import Settings
+    from cotm_bertini.api import costs
+    from cotm_bertini.model.framework import compiled
+
+    monkeypatch.setenv("COTM_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setattr(compiled, "_LOADED", {})
+    seen = []
+    monkeypatch.setattr(costs, "sample_rate", lambda ps, *a: seen.append(ps) or (0.5, 3))
+    settings = Settings(generic="total-degree")
+    fw = _series(tmp_path)
+    sizes = sorted(s.paths for s in costs.cost(fw, settings, sample=False).sets)
+    monkeypatch.setattr(costs, "SAMPLE_MAX_PATHS", sizes[0])  # only the smallest set fits
+    c = costs.cost(fw, settings, sample=True)
+    assert c.measured and len(seen) == 1
+    assert len(seen[0].variables) == min(s.unknowns for s in c.sets)
+    monkeypatch.setattr(costs, "SAMPLE_MAX_PATHS", sizes[0] - 1)  # none fits
+    c = costs.cost(fw, settings, sample=True)
+    assert not c.measured and len(seen) == 1
+    assert f"every taut set has more than {sizes[0] - 1:,} paths" in c.rate_source

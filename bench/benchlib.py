@@ -156,15 +156,19 @@ def multihomogeneous_bezout(system, groups: list[list[str]]) -> int:
     return int(sp.Poly(sp.expand(product), *z).coeff_monomial(monomial))
 
 
-def example_system(name: str):
-    """The first taut set's system of examples/<name>.toml, its start centre and groups."""
+def example_system(name: str, taut: tuple[str, ...] | None = None):
+    """The system of examples/<name>.toml's taut set `taut` (default: its first with isolated
+    equilibria), its start centre and groups."""
     import cotm_bertini as cb
     from cotm_bertini.model.framework.compiled import framework_system, variable_groups
     from cotm_bertini.model.framework.units import normalized_slots
     from cotm_bertini.point import taut_sets
 
     fw = cb.Framework.from_toml(BENCH.parent / "examples" / f"{name}.toml")
-    fs = next(f for f in (framework_system(fw, t) for t in taut_sets(fw)) if not f.free)
+    if taut is not None:
+        fs = framework_system(fw, taut)
+    else:
+        fs = next(f for f in (framework_system(fw, t) for t in taut_sets(fw)) if not f.free)
     centre = normalized_slots(fw.at_defaults())
     return fs.ps, {n: centre[n] for n in fs.ps.parameters}, variable_groups(fs)
 

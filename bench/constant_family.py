@@ -19,27 +19,22 @@ import time
 from pathlib import Path
 
 import pandas as pd
-from benchlib import BENCH, show, write_csv
-
-ROOT = BENCH.parent
+from benchlib import BENCH, example_system, show, write_csv
 
 
 def _system(spec: str):
-    """(parametric system, start centre) of an example's taut set: "name" (its first set with
-    isolated equilibria) or "name:cable,cable"."""
+    """(parametric system, start centre) of "name" (its first taut set with isolated
+    equilibria) or "name:cable,cable"."""
     import cotm_bertini as cb
-    from cotm_bertini.model.framework.compiled import framework_system
-    from cotm_bertini.model.framework.units import normalized_slots
-    from cotm_bertini.point import taut_sets
 
     name, _, taut = spec.partition(":")
-    fw = cb.Framework.from_toml(ROOT / "examples" / f"{name}.toml")
-    if taut:
-        fs = framework_system(fw, tuple(taut.split(",")))
-    else:
-        fs = next(f for f in (framework_system(fw, t) for t in taut_sets(fw)) if not f.free)
-    slots = normalized_slots(fw.at_defaults())
-    return fs.ps, {n: slots[n] for n in fs.ps.parameters}
+    fw = cb.Framework.from_toml(BENCH.parent / "examples" / f"{name}.toml")
+    cables = {c.name for c in fw.cables}
+    unknown = sorted(set(taut.split(",")) - cables) if taut else []
+    if unknown:
+        raise SystemExit(f"constant_family.py: {name} has no cable {unknown[0]!r}")
+    ps, centre, _ = example_system(name, tuple(taut.split(",")) if taut else None)
+    return ps, centre
 
 
 def _constant_family(run):

@@ -1,8 +1,9 @@
 """Independent plain-numpy statics of spatial bar-and-cable frameworks (no package code): free
 nodes, fixed anchors, bars of fixed length between any two points, tension-only cables of free
 length L0 (energy k/2 max(|r| - L0, 0)^2). The checks of the spatial examples compare the
-package's equilibria with the critical points found here by Newton's method on the Lagrange
-conditions from thousands of random poses, one smooth energy per taut set."""
+package's taut-set pruning (and, once it solves them, its equilibria) with the critical points
+found here by Newton's method on the Lagrange conditions from thousands of random poses, per
+taut set or on the piecewise energy."""
 
 from __future__ import annotations
 
@@ -122,14 +123,19 @@ def morse_index(H: np.ndarray, A: np.ndarray) -> int:
     return -1 if np.min(np.abs(ev)) < 1e-7 else int(np.sum(ev < 0))
 
 
+def _parent(fw: Spatial, node: str, placed) -> tuple[str, float] | None:
+    """(point, length) of a bar that ties `node` to a point already in `placed`, or None."""
+    return next(((b if a == node else a, length) for a, b, length in fw.bars
+                 if node in (a, b) and (b if a == node else a) in placed), None)  # fmt: skip
+
+
 def random_poses(fw: Spatial, count: int, rng: np.random.Generator, scale: float) -> np.ndarray:
     """Random poses that meet the bars: each free node, in order, a bar's length from a point
     already placed in a random direction (Gaussian about the anchors' centroid if none)."""
     centre = np.mean(np.array(list(fw.anchors.values()), float), axis=0)
     placed = {n: np.broadcast_to(np.asarray(p, float), (count, 3)) for n, p in fw.anchors.items()}
     for node in fw.free:
-        bar = next(((b if a == node else a, length) for a, b, length in fw.bars
-                    if node in (a, b) and (b if a == node else a) in placed), None)  # fmt: skip
+        bar = _parent(fw, node, placed)
         if bar is None:
             placed[node] = centre + scale * rng.standard_normal((count, 3))
         else:
@@ -138,13 +144,12 @@ def random_poses(fw: Spatial, count: int, rng: np.random.Generator, scale: float
     return np.concatenate([placed[n] for n in fw.free], axis=1)
 
 
-def _parents(fw: Spatial) -> list[tuple[str, float]]:
+def parents(fw: Spatial) -> list[tuple[str, float]]:
     """Each free node's parent: the point a bar ties it to, placed before it (a tree of bars
     rooted at the anchors; every free node must hang from one)."""
     seen, out = set(fw.anchors), []
     for node in fw.free:
-        parent = next(((b if a == node else a, length) for a, b, length in fw.bars
-                       if node in (a, b) and (b if a == node else a) in seen), None)  # fmt: skip
+        parent = _parent(fw, node, seen)
         if parent is None:
             raise ValueError(f"free node {node} hangs from no bar")
         out.append(parent)
@@ -156,7 +161,7 @@ def _pose(fw: Spatial, U: np.ndarray) -> np.ndarray:
     """Poses from directions U (s x 3m, any length): each node its bar's length from its
     parent along its direction, so every bar holds exactly."""
     placed = {n: np.broadcast_to(np.asarray(p, float), (len(U), 3)) for n, p in fw.anchors.items()}
-    for i, (node, (parent, length)) in enumerate(zip(fw.free, _parents(fw), strict=True)):
+    for i, (node, (parent, length)) in enumerate(zip(fw.free, parents(fw), strict=True)):
         u = U[:, 3 * i : 3 * i + 3]
         placed[node] = placed[parent] + length * u / np.linalg.norm(u, axis=1)[:, None]
     return np.concatenate([placed[n] for n in fw.free], axis=1)

@@ -120,7 +120,7 @@ def _symmetric_poses(fw: tp.Spatial, name: str, X: np.ndarray) -> np.ndarray:
 def _reflections(fw: tp.Spatial, X: np.ndarray) -> np.ndarray:
     """Each pose with one node reflected through the point its strut hangs from, the nodes that
     hang from it (directly or not) moved along: every bar still holds."""
-    parents = dict(zip(fw.free, (p for p, _ in tp._parents(fw)), strict=True))
+    parents = dict(zip(fw.free, (p for p, _ in tp.parents(fw)), strict=True))
     out = []
     for node in fw.free:
         P = X.reshape(len(X), -1, 3).copy()

@@ -20,7 +20,7 @@ import cotm_bertini as cb
 
 def main() -> None:
     from cotm_bertini.analysis.certify.curve import certify_samples
-    from cotm_bertini.analysis.design.fold_curves import _grid, parallel_samples
+    from cotm_bertini.catastrophe.paper_folds import _grid, parallel_samples
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--points", type=int, default=41, help="grid points a side of the map")
@@ -75,7 +75,7 @@ def main() -> None:
 
 def _fold_run(fw, x: str, xr: tuple, y: str, yr: tuple) -> tuple[float, float, dict]:
     """(wall seconds, of which the witness sets' solve or load, the record) of one fold map."""
-    from cotm_bertini.continuation.framework_folds import framework_fold_curves
+    from cotm_bertini.catastrophe.framework_folds import framework_fold_curves
 
     t0 = time.perf_counter()
     _, rec = framework_fold_curves(fw, x, xr, y, yr, workers=2)
@@ -86,11 +86,11 @@ def _fold_run(fw, x: str, xr: tuple, y: str, yr: tuple) -> tuple[float, float, d
 
 
 def framework_folds(with_cotm: bool = False) -> None:
-    """Fold curves by the Bertini route (continuation/framework_folds.py): Zeeman over the
+    """Fold curves by the Bertini route (catastrophe/framework_folds.py): Zeeman over the
     issue's window, and with `with_cotm` cotm.toml over (0, 14]^2 against the closed-form
     route's time on the built-in model (target: at most 10 times it), each run twice (the
     witness sets solved, or loaded from the cache, then in memory)."""
-    from cotm_bertini.analysis.design.fold_curves import fold_curves_proved
+    from cotm_bertini.catastrophe.paper_folds import fold_curves_proved
 
     runs = [("zeeman", "x", (-0.6, 0.8), "y", (-0.8, 0.2))]
     if with_cotm:

@@ -135,7 +135,7 @@ def main() -> None:
     sys.path.insert(0, str(ROOT))
     import cotm_bertini as cb
     from cotm_bertini.backends.start_system import bezout_number
-    from cotm_bertini.continuation.framework_folds import _degrees, _groups
+    from cotm_bertini.catastrophe.framework_folds import _degrees, _groups
     from cotm_bertini.model.framework.folds import curve_system
 
     rows, paths = [], []

@@ -30,7 +30,7 @@ _EXPORTS = {
     "barriers": "cotm_bertini.api.barriers",
     "Barriers": "cotm_bertini.api.barriers",
     "design": "cotm_bertini.analysis.design.free_lengths",
-    "fold_curves": "cotm_bertini.analysis.design.fold_curves",
+    "fold_curves": "cotm_bertini.catastrophe.paper_folds",
     "design_map": "cotm_bertini.api.maps",
     "DesignMap": "cotm_bertini.api.maps",
     "Design": "cotm_bertini.analysis.design.free_lengths",

@@ -8,7 +8,7 @@ from pathlib import Path
 PACKAGE = Path(__file__).resolve().parent.parent / "cotm_bertini"
 
 # Lower layers never import higher ones (data flows params -> model -> backends -> analysis ->
-# point -> continuation -> io/plot -> api -> paper -> cli).
+# point -> continuation -> catastrophe/motion -> io/plot -> api -> paper -> cli).
 LAYERS = [
     {"_version", "errors", "fs", "versions", "resources", "columns", "literals", "progress"},
     {"params", "settings"},
@@ -17,6 +17,7 @@ LAYERS = [
     {"analysis"},
     {"point"},
     {"continuation"},
+    {"catastrophe", "motion"},
     {"io", "plot"},
     {"api"},
     {"paper"},

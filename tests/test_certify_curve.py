@@ -19,8 +19,8 @@ import cotm_bertini as cb
 from cotm_bertini.analysis.certify.curve import certify_samples
 from cotm_bertini.analysis.certify.mechanism import certify_table
 from cotm_bertini.analysis.certify.search import COVER_CELLS, GEOMETRY, _cover
-from cotm_bertini.analysis.design.fold_curves import _grid, parallel_samples
 from cotm_bertini.analysis.design.free_lengths import parallel_cross, parallel_roots
+from cotm_bertini.catastrophe.paper_folds import _grid, parallel_samples
 from cotm_bertini.point import solve_point
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "stress"))

@@ -77,7 +77,7 @@ def test_direct_solves_either_side_differ_by_two(folds, index):
 
 
 def _neighbour_segments(folds, window) -> np.ndarray:
-    """The sampled fold curves as segments (window units, for region_changes.uncrossed): every
+    """The sampled fold curves as segments (window units, for regions.uncrossed): every
     pair of fold points that are neighbouring samples of one curve (poses within 1 deg but not
     the same pose, free lengths within 0.1 m), as in `_crossings`."""
     (x0, x1), (y0, y1) = window
@@ -99,8 +99,8 @@ def test_stable_count_changes_only_across_fold_curves(folds):
     """Completeness on the paper geometry: wherever direct solves on neighbouring grid points
     disagree on the number of stable equilibria, a fold curve crosses the segment between them
     (41 x 41 over (0, 14] with COTM_STRESS=full, 11 x 11 otherwise). The check is the one of
-    every framework's map (analysis.design.region_changes), on the paper's sampled curve."""
-    from cotm_bertini.analysis.design.region_changes import count_changes, grid_window, uncrossed
+    every framework's map (catastrophe.regions), on the paper's sampled curve."""
+    from cotm_bertini.catastrophe.regions import count_changes, grid_window, uncrossed
 
     n = 41 if os.environ.get("COTM_STRESS") == "full" else 11
     lo = 14.0 / n

@@ -95,7 +95,7 @@ def test_bertini_counts_the_paths_we_count(fold):
     import bertini
 
     from cotm_bertini.backends.render import render_system
-    from cotm_bertini.continuation.framework_folds import _degrees, _groups
+    from cotm_bertini.catastrophe.framework_folds import _degrees, _groups
 
     _, _, cs, _ = fold
     groups = _groups(cs, 1)

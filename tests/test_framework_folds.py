@@ -11,7 +11,7 @@ import pytest
 from framework_physics import scan_critical_points, zeeman_energy
 
 import cotm_bertini as cb
-from cotm_bertini.continuation.framework_folds import SPACING, framework_fold_curves
+from cotm_bertini.catastrophe.framework_folds import SPACING, framework_fold_curves
 from cotm_bertini.errors import ParameterError
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
@@ -309,10 +309,10 @@ def test_cotm_relaxed_folds_against_plain_geometry_and_the_closed_form():
     """cotm.toml's relaxed folds (both springs at their free length, where the fold system is
     singular): each point's free lengths are its spring lengths and the lengths' Jacobian in
     the two angles is singular (plain numpy, central differences), each changes the stable
-    count, and they lie on the closed form's relaxed family (analysis/design/fold_curves.py) and
+    count, and they lie on the closed form's relaxed family (catastrophe/paper_folds.py) and
     cover it in the window."""
-    from cotm_bertini.analysis.design.fold_curves import fold_curves
-    from cotm_bertini.continuation import framework_folds as ff
+    from cotm_bertini.catastrophe import framework_folds as ff
+    from cotm_bertini.catastrophe.paper_folds import fold_curves
     from cotm_bertini.continuation.runner import worker_pool
     from cotm_bertini.model.framework.folds import RELAXED, curve_system
 
@@ -349,13 +349,13 @@ def test_cotm_relaxed_folds_against_plain_geometry_and_the_closed_form():
 
 def test_cotm_toml_folds_lie_on_the_closed_form_curves():
     """The fold curves of examples/cotm.toml by the Bertini route, over the paper's window
-    (0, 14]^2, against the built-in closed form (analysis/design/fold_curves.py: the parallel curve
+    (0, 14]^2, against the built-in closed form (catastrophe/paper_folds.py: the parallel curve
     and the quadratic det H(t)), which shares no code with the framework route: every Bertini fold
     point has its pose on the parallel curve and its free lengths those the closed form gives at
     that pose (1e-6 relative), and every closed-form fold point in the window is within the
     polyline spacing of a Bertini one."""
-    from cotm_bertini.analysis.design.fold_curves import fold_curves, tensioned_free_lengths
     from cotm_bertini.analysis.design.free_lengths import generalised_forces, parallel_cross
+    from cotm_bertini.catastrophe.paper_folds import fold_curves, tensioned_free_lengths
 
     p = cb.Params.case("case3")
     fw = cb.Framework.from_toml(EXAMPLES / "cotm.toml")

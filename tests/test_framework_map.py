@@ -23,8 +23,8 @@ from framework_physics import (
 )
 
 import cotm_bertini as cb
-from cotm_bertini.analysis.design.region_changes import count_changes, unexplained
-from cotm_bertini.api.maps import grid_values
+from cotm_bertini.catastrophe.maps import grid_values
+from cotm_bertini.catastrophe.regions import count_changes, unexplained
 
 pytestmark = pytest.mark.xdist_group("framework_examples")  # the Zeeman fold sets: solved once
 

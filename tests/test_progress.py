@@ -217,7 +217,7 @@ def test_fold_curves_say_each_stage(monkeypatch, capsys):
     """A map's fold curves (Zeeman, the sweep route) report each stage with its count: the
     crossings' solves by vertical line (9), the lines' branches (18), the tracing from every
     seed found, the classification of the points."""
-    from cotm_bertini.continuation.framework_folds import framework_fold_curves
+    from cotm_bertini.catastrophe.framework_folds import framework_fold_curves
 
     monkeypatch.setenv(progress.ENV_DELAY, "0")
     monkeypatch.setenv(progress.ENV_SECONDS, "0")

@@ -306,7 +306,7 @@ def barriers(args: argparse.Namespace) -> int:
 def _map_axes(args: argparse.Namespace, model) -> tuple[tuple, tuple]:
     """((x, (from, to)), (y, (from, to))) of `map`: the paper's free lengths (0 to 14 m by
     default), or two parameters of a framework, named with their ranges."""
-    from ..api.maps import FREE_LENGTHS, PAPER_WINDOW
+    from ..catastrophe.maps import FREE_LENGTHS, PAPER_WINDOW
     from ..params import Params
 
     if isinstance(model, Params):

@@ -94,7 +94,7 @@ _STYLES = (
 
 def _curves(ax: Axes, folds: pd.DataFrame, axes: tuple[str, str], grid: tuple) -> list:
     """A framework's fold curves as polylines by curve_id in order of arc."""
-    from ..analysis.design.region_changes import polylines
+    from ..catastrophe.regions import polylines
 
     window = tuple((g.min(), g.max()) for g in grid)
     switch = (folds.kind == "cable_switch").to_numpy()

@@ -19,11 +19,11 @@ from itertools import product
 import numpy as np
 import pandas as pd
 
-from ...model.kinematics import spring_jacobian, spring_second_derivatives, spring_vectors
-from ...params import Params
-from ..critical_points import deg_distance
-from ..energy_terms import curvature
-from .free_lengths import generalised_forces, parallel_cross, parallel_roots
+from ..analysis.critical_points import deg_distance
+from ..analysis.design.free_lengths import generalised_forces, parallel_cross, parallel_roots
+from ..analysis.energy_terms import curvature
+from ..model.kinematics import spring_jacobian, spring_second_derivatives, spring_vectors
+from ..params import Params
 
 FOLD_COLUMNS = [
     "L01", "L02", "gamma1_deg", "gamma2_deg", "d1", "d2", "physical", "family", "curve_id",
@@ -114,7 +114,7 @@ def fold_curves_proved(params: Params, points: int = 1500) -> tuple[pd.DataFrame
     """`fold_curves` from samples proved to leave no part of the parallel curve out
     (`certify/curve.certify_samples`: crossings the sampler missed are added), and the
     certificate (the run.json `certificate` record of the map)."""
-    from ..certify.curve import certify_samples
+    from ..analysis.certify.curve import certify_samples
 
     record, samples = certify_samples(params, parallel_samples(params, points), _grid(points))
     return _folds(params, samples, points), record
@@ -140,7 +140,7 @@ def zero_length_ends(table: pd.DataFrame, length_unit: float) -> pd.DataFrame:
     .zero_length times L3) get kind `zero_length` and are not physical: V is not smooth there
     (a spring with a free length at zero length), so a fold curve running into that point ends
     there; it neither folds nor turns back in a cusp."""
-    from ...settings import Tolerances
+    from ..settings import Tolerances
 
     lengths = table[["d1", "d2"]].to_numpy(float)
     short = (lengths < Tolerances().zero_length * length_unit).any(axis=1)

@@ -9,7 +9,7 @@ window's edges among them) are found by one of two routes, both Bertini's:
 - "sweep": the equilibria of the taut set are solved at the crossings of the seed lines
   (parameter homotopy from the equilibrium system's generic set), and every real branch through
   a crossing is traced along each line; its turning points are the folds on the line
-  (continuation/fold_sweep.py, which says what it cannot see). For systems whose witness set is
+  (catastrophe/fold_sweep.py, which says what it cannot see). For systems whose witness set is
   too costly (cotm.toml's: 1,408 paths, each slow in Bertini 2 for a 1,226-term fold equation).
   A relaxed fold (model/framework/folds.py), where the fold system is singular, is a turning
   point Newton cannot refine: the relaxed folds' own system is always solved by its witness set
@@ -17,7 +17,7 @@ window's edges among them) are found by one of two routes, both Bertini's:
 
 "auto" takes the witness route when the witness set's multihomogeneous path count is at most
 WITNESS_MAX_PATHS, else the sweep. Each real fold point found seeds a pseudo-arclength trace of
-its curve in (X, x, y) (continuation/curve_trace.py) to the window's edge or until it closes,
+its curve in (X, x, y) (catastrophe/curve_trace.py) to the window's edge or until it closes,
 and a seed on a curve already traced is skipped. Cusps are where the curve's image in the plane
 turns back (refined by bisection on the image's speed along the incoming direction) and are
 confirmed by the vanishing of w . F_XX[v, v] (w, v the left and right null vectors of J_X F: the
@@ -43,6 +43,7 @@ from ..analysis.framework_classify import (
 from ..backends.endpoints import Endpoints
 from ..backends.homotopy import generic_set, track
 from ..backends.start_system import bezout_number, fewest_paths_groups, group_degrees
+from ..continuation.runner import Run, worker_pool
 from ..errors import ParameterError
 from ..model.framework.compiled import framework_system
 from ..model.framework.folds import (
@@ -58,7 +59,6 @@ from ..progress import Progress, say
 from ..settings import Settings, Tolerances
 from .curve_trace import Traced, Window, trace, turning_point
 from .fold_sweep import curve_equations, is_real, long_enough, run_reported, sweep_seeds
-from .runner import Run, worker_pool
 
 SEED_ROUTES = ("auto", "witness", "sweep")
 WITNESS_MAX_PATHS = 600  # "auto": above this many paths the fold witness set is not solved

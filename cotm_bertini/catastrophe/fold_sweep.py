@@ -18,6 +18,7 @@ from functools import cache
 
 import numpy as np
 
+from ..continuation.runner import Run
 from ..model.framework.compiled import framework_system, variable_groups
 from ..model.framework.folds import CurveSystem
 from ..model.framework.spec import Framework
@@ -26,7 +27,6 @@ from ..model.polynomial import PolySystem
 from ..progress import Progress
 from ..settings import Settings, Tolerances
 from .curve_trace import Traced, Window, newton, remembered, trace, turning_point
-from .runner import Run
 
 BRANCH_SPACING = 0.02  # a branch's consecutive points: at most this fraction of the line apart
 BRANCH_HMAX = 0.05  # largest step of a branch in (X, x, y), relative to 1 + max |z|

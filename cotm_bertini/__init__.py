@@ -34,6 +34,8 @@ _EXPORTS = {
     "design_map": "cotm_bertini.api.maps",
     "DesignMap": "cotm_bertini.api.maps",
     "Design": "cotm_bertini.analysis.design.free_lengths",
+    "move": "cotm_bertini.api.motion",
+    "Move": "cotm_bertini.api.motion",
     "CertificateError": "cotm_bertini.errors",
     "CotmError": "cotm_bertini.errors",
     "ParameterError": "cotm_bertini.errors",

@@ -306,6 +306,56 @@ FRAMEWORK_EVENTS = {
 }
 
 
+_MOVE_HEAD = {
+    "step": "0, 1, ...: the row's order along the move",
+    "s": "path position: 0 at the first waypoint, k at waypoint k, linear in between",
+    "NAME (each path parameter)": "its value at this row",
+    "event": "step (one of `steps` equal steps a segment), snap_from (the followed state where "
+    "it ends: a fold or a cable switch, located to 1e-10 in s) or snap_to (the minimum it fell "
+    "into, just past that point)",
+}
+
+MOVE = {
+    **_MOVE_HEAD,
+    "gamma1_deg, gamma2_deg": "the state's angles (deg) in [0, 360)",
+    "d1, d2": "spring lengths (m)",
+    "energy": "V (J)",
+    "hess_min_eig": "the Hessian's smallest eigenvalue over max(k1, k2) L3^2: > 0 at every "
+    "step row (the state is a minimum), near 0 at a fold",
+}
+
+FRAMEWORK_MOVE = {
+    **_MOVE_HEAD,
+    "BODY.angle_deg (BODY.qw ... BODY.qz), BODY.POINT.x ..., NODE.x ...": "the state's pose, "
+    "named as in solutions.csv",
+    "NAME.length": "every link's length",
+    "NAME.tension": "spring: k (d - L0); cable: the same when taut, 0 when slack",
+    "NAME.taut": "cable: longer than its free length",
+    "energy": "V, as in solutions.csv",
+    "hess_min_eig": "the reduced Hessian's smallest eigenvalue (normalised units, as in "
+    "solutions.csv): > 0 at every step row, near 0 at a fold",
+}
+
+SNAPS = {
+    "snap": "1, 2, ... along the move",
+    "s": "path position where the followed state ends (its last located point)",
+    "NAME (each path parameter)": "its value there",
+    "kind": "fold (the softest Hessian eigenvalue fell below 1e-3, normalised), cable_switch (a "
+    "cable within 1e-6 length units of its free length: V is piecewise there) or unexplained "
+    "(neither: reported as a warning)",
+    "released": "V(state before) - V(minimum after), both at the parameter values just past the "
+    "end (J, or the file's units of k length^2)",
+    "located_to": "the width of the final bracket of the end, in the path's parameters (the "
+    "largest change of one parameter)",
+    "softest_eig": "the softest normalised Hessian eigenvalue of the state where it ends",
+    "cable_gap": "the smallest |d - L0| over cables there (length units; inf: no cable)",
+    "landed": "the gradient flow from just past the end reached a minimum (else the move "
+    "stops there, status incomplete)",
+    "before.COLUMN, after.COLUMN": "the pose columns and energy of the state where it ends "
+    "and of the minimum it falls into",
+}
+
+
 def markdown(title: str, columns: dict[str, str], head: str = "column") -> str:
     """A Markdown table of columns (or other names) and their meanings."""
     lines = [f"## {title}", "", f"| {head} | meaning |", "|---|---|"]
@@ -317,7 +367,7 @@ def reference(*tables: str, title: str = "Columns of the CSV files in this folde
     """The column reference of a run folder: 'solutions', 'counts', 'sweep', 'events',
     'barriers', 'folds', 'regions', 'design', 'framework', 'framework_counts',
     'framework_sweep', 'framework_events', 'framework_folds', 'framework_regions',
-    'framework_barriers'."""
+    'framework_barriers', 'move', 'framework_move', 'snaps'."""
     known = {
         "solutions": ("solutions.csv", SOLUTIONS),
         "counts": ("counts (run.json `counts`, `res.counts`)", COUNTS, "count"),
@@ -325,6 +375,9 @@ def reference(*tables: str, title: str = "Columns of the CSV files in this folde
         "events": ("events.csv", EVENTS),
         "barriers": ("barriers.csv", BARRIERS),
         "framework_barriers": ("barriers.csv of a framework", FRAMEWORK_BARRIERS),
+        "move": ("trajectory.csv (`cb.move`)", MOVE),
+        "framework_move": ("trajectory.csv of a framework's move", FRAMEWORK_MOVE),
+        "snaps": ("snaps.csv", SNAPS),
         "folds": ("folds.csv (`cb.fold_curves`)", FOLDS),
         "regions": ("regions.csv", REGIONS),
         "design": ("the design CSV (`cotm-bertini design --out`)", DESIGN),
@@ -358,5 +411,8 @@ def document() -> str:
         "framework_folds",
         "framework_regions",
         "framework_barriers",
+        "move",
+        "framework_move",
+        "snaps",
         title="Columns of the CSV files",
     )

@@ -17,6 +17,7 @@ point if its L0 > 0: the flow is not smooth there) is flagged, never hidden.
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -25,6 +26,7 @@ import pandas as pd
 
 from ..model.compiled import energy, energy_gradient, energy_hessian
 from ..params import Params
+from .classify import wrap_degrees
 from .critical_points import deg_distance
 from .design.free_lengths import generalised_forces
 
@@ -41,16 +43,23 @@ class Flow(Protocol):
 
     newton_tol: float  # converged once Newton's step is shorter than this
     zero_length: float  # a spring shorter than this is flagged (user units)
+    length_unit: float  # the model's length unit (user units)
+    hessian_unit: float  # eigh's eigenvalues over this are in normalised units
     pose_names: list[str]  # the barriers.csv columns that place the saddle
 
     def saddles(self, solutions: pd.DataFrame) -> pd.DataFrame: ...
     def saddle(self, row) -> tuple[np.ndarray, np.ndarray, np.ndarray]: ...
+    def state(self, row) -> np.ndarray: ...
+    def at(self, model) -> Flow: ...
     def pose(self, row) -> dict: ...
     def energy(self, x: np.ndarray) -> float: ...
     def gradient(self, x: np.ndarray) -> np.ndarray: ...
     def newton(self, x: np.ndarray, grad: np.ndarray) -> np.ndarray | None: ...
+    def eigh(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]: ...
     def move(self, x: np.ndarray, step: np.ndarray) -> np.ndarray: ...
     def shortest(self, x: np.ndarray) -> float: ...
+    def cable_gap(self, x: np.ndarray) -> float: ...
+    def rows(self, path: np.ndarray) -> pd.DataFrame: ...
     def match(self, end: np.ndarray) -> int | None: ...
     def record(self, path: np.ndarray) -> object: ...
 
@@ -158,10 +167,21 @@ class PaperFlow:
     pose_names = ["saddle_gamma1_deg", "saddle_gamma2_deg"]
 
     def __init__(self, params: Params, solutions: pd.DataFrame):
-        self.params = params
-        self.zero_length = ZERO_LENGTH * params.L3
+        self._values(params)
         phys = solutions[solutions.physical.astype(bool)]
         self.minima = phys[phys.kind == "min"]
+
+    def _values(self, params: Params) -> None:
+        self.params = params
+        self.length_unit = params.L3
+        self.zero_length = ZERO_LENGTH * params.L3
+        self.hessian_unit = max(params.k1, params.k2) * params.L3**2  # J/rad^2
+
+    def at(self, params: Params) -> PaperFlow:
+        """The same flow at other parameter values (states carry over: angles)."""
+        out = copy.copy(self)
+        out._values(params)
+        return out
 
     def saddles(self, solutions: pd.DataFrame) -> pd.DataFrame:
         """The physical saddles (on the torus every saddle has index 1)."""
@@ -170,9 +190,17 @@ class PaperFlow:
 
     def saddle(self, row) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The saddle's angles (rad), Hessian eigenvalues and unstable eigenvector."""
-        x0 = np.radians([row.gamma1_deg, row.gamma2_deg])
-        eigval, eigvec = np.linalg.eigh(energy_hessian(self.params, x0[0], x0[1])[0])
+        x0 = self.state(row)
+        eigval, eigvec = self.eigh(x0)
         return x0, eigval, eigvec[:, 0]
+
+    def state(self, row) -> np.ndarray:
+        """A solutions row's angles (rad)."""
+        return np.radians([float(row.gamma1_deg), float(row.gamma2_deg)])
+
+    def eigh(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Eigenvalues (ascending, J/rad^2) and eigenvectors of the Hessian of V."""
+        return np.linalg.eigh(energy_hessian(self.params, x[0], x[1])[0])
 
     def pose(self, row) -> dict:
         """The saddle's barriers.csv pose columns."""
@@ -189,10 +217,10 @@ class PaperFlow:
 
     def newton(self, x: np.ndarray, grad: np.ndarray) -> np.ndarray | None:
         """The Newton step where the Hessian is positive definite, else None."""
-        hess = energy_hessian(self.params, x[0], x[1])[0]
-        if np.linalg.eigvalsh(hess).min() <= 0:
+        eig, vec = self.eigh(x)
+        if eig.min() <= 0:
             return None
-        return -np.linalg.solve(hess, grad)
+        return -vec @ ((vec.T @ grad) / eig)
 
     def move(self, x: np.ndarray, step: np.ndarray) -> np.ndarray:
         """Angles are their own coordinates."""
@@ -201,6 +229,19 @@ class PaperFlow:
     def shortest(self, x: np.ndarray) -> float:
         """The shorter spring (m)."""
         return float(generalised_forces(self.params, x[0], x[1])[1].min())
+
+    def cable_gap(self, x: np.ndarray) -> float:
+        """No cables: nothing switches."""
+        return np.inf
+
+    def rows(self, path: np.ndarray) -> pd.DataFrame:
+        """States as solutions.csv-style rows: the angles (deg, wrapped), d1, d2 (m), V (J)."""
+        path = np.atleast_2d(path)
+        d = generalised_forces(self.params, path[:, 0], path[:, 1])[1]
+        deg = wrap_degrees(np.degrees(path))
+        return pd.DataFrame({"gamma1_deg": deg[:, 0], "gamma2_deg": deg[:, 1],
+                             "d1": d[0], "d2": d[1],
+                             "energy": [self.energy(x) for x in path]})  # fmt: skip
 
     def match(self, end: np.ndarray) -> int | None:
         """The solution_id of the minimum the descent ended at (None: not a listed minimum)."""

@@ -15,6 +15,7 @@ multipliers from least squares.
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Callable
 
 import numpy as np
@@ -41,14 +42,14 @@ class FrameworkFlow:
     """The barriers driver's model of a framework (see the module docstring)."""
 
     newton_tol = 1e-12
+    hessian_unit = 1.0  # the reduced Hessian is in normalised units already
 
     def __init__(self, fw: Framework, pose_names: list[str],
                  match: Callable[[pd.DataFrame], int | None]):  # fmt: skip
-        self.fw, self.pose_names, self._match = fw, list(pose_names), match
+        self.pose_names, self._match = list(pose_names), match
         self.length, self.stiffness = units(fw)
         self.zero_length = ZERO_LENGTH * self.length
-        slots = normalized_slots(fw)
-        self.P = slot_vector(slots)
+        self.length_unit = self.length
         self.lay = layout(fw)
         self.every = framework_system(fw, tuple(c.name for c in fw.cables))
         names = self.every.ps.variables
@@ -56,16 +57,30 @@ class FrameworkFlow:
         self.config = sum(not v.startswith(("d_", "w_", "mu_")) for v in names)
         self.m = self.every.local_size
         self.links = [x for x in fw.links if x.kind != "bar"]  # as first_order lists them
+        self.cable = np.array([x.kind == "cable" for x in self.links], dtype=bool)
+        self.index = {p: k for k, p in enumerate(self.every.points)}
+        self.ends = (np.array([self.index[x.a] for x in self.links], dtype=int),
+                     np.array([self.index[x.b] for x in self.links], dtype=int))  # fmt: skip
+        self._values(fw)
+
+    def _values(self, fw: Framework) -> None:
+        """What depends on the parameter values (in the units of the file's own values)."""
+        self.fw = fw
+        slots = normalized_slots(fw)
+        self.P = slot_vector(slots)
         self.k = np.array([slots[f"k_{x.name}"] for x in self.links])
         self.L0 = np.array([slots[f"L0_{x.name}"] for x in self.links])
-        self.cable = np.array([x.kind == "cable" for x in self.links], dtype=bool)
-        index = {p: k for k, p in enumerate(self.every.points)}
-        self.ends = (np.array([index[x.a] for x in self.links], dtype=int),
-                     np.array([index[x.b] for x in self.links], dtype=int))  # fmt: skip
         axes = "xyz"[: fw.dim]
-        self.forces = [(index[ld.point], np.array([slots[f"f_{ld.name}_{a}"] for a in axes]))
+        self.forces = [(self.index[ld.point], np.array([slots[f"f_{ld.name}_{a}"] for a in axes]))
                        for ld in fw.loads]  # fmt: skip
         self._memo = (b"", np.zeros(0))
+
+    def at(self, fw: Framework) -> FrameworkFlow:
+        """The same framework at other parameter values (`fw`: self.fw.replace(...)): the
+        structure, units and states are shared, so a state carries over."""
+        out = copy.copy(self)
+        out._values(fw)
+        return out
 
     # -- evaluation -------------------------------------------------------------------------
 
@@ -142,6 +157,18 @@ class FrameworkFlow:
             return None
         return -vec @ ((vec.T @ grad) / eig)
 
+    def eigh(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Eigenvalues (ascending, normalised units) and eigenvectors (local coordinates) of
+        the reduced Hessian at x; none where the structure taut at x moves freely."""
+        return self._reduced_hessian(x)
+
+    def cable_gap(self, x: np.ndarray) -> float:
+        """The smallest |d - L0| over the cables (user length units): 0 at a switch."""
+        if not self.cable.any():
+            return np.inf
+        d = self._lengths(self._coords(x))
+        return float(np.abs(d - self.L0)[self.cable].min()) * self.length
+
     def _reduced_hessian(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Eigenpairs of the Lagrangian's Hessian on the tangent space, for the cables taut at
         x (normalised units); none where that structure moves freely."""
@@ -208,11 +235,15 @@ class FrameworkFlow:
     def saddle(self, row) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The saddle's state (from its pose columns, on the constraint set), the reduced
         Hessian's eigenvalues (normalised units) and the unstable eigenvector (local)."""
-        x0 = self.move(self._state(row), np.zeros(self.m))
+        x0 = self.state(row)
         eig, vec = self._reduced_hessian(x0)
         return x0, eig, vec[:, 0]
 
-    def _state(self, row) -> np.ndarray:
+    def state(self, row) -> np.ndarray:
+        """A solutions row's state, on the constraint set."""
+        return self.move(self._pose_state(row), np.zeros(self.m))
+
+    def _pose_state(self, row) -> np.ndarray:
         parts, axes = [], "xyz"[: self.fw.dim]
         for body in self.lay.rotations:
             if self.fw.dim == 2:
@@ -229,13 +260,24 @@ class FrameworkFlow:
         return {name: float(row[name]) for name in self.pose_names}
 
     def rows(self, path: np.ndarray) -> pd.DataFrame:
-        """States as solutions.csv-style rows: pose columns, every link's length, V (J)."""
+        """States as solutions.csv-style rows: pose columns, every link's length, each spring's
+        and cable's tension (and whether a cable is taut), V (J)."""
         X = self._full(path)
         var = {name: X[:, k] for k, name in enumerate(self.every.ps.variables)}
         pts = positions(self.every, X, self.P, self.fw.dim, self.length)
         cols = pose_columns(self.fw, self.every, var, pts)
+        force = self.stiffness * self.length  # the file's force unit
         for x in self.fw.links:
-            cols[f"{x.name}.length"] = np.linalg.norm(pts[x.a].real - pts[x.b].real, axis=1)
+            d = np.linalg.norm(pts[x.a].real - pts[x.b].real, axis=1)
+            cols[f"{x.name}.length"] = d
+            if x.kind == "bar":
+                continue
+            slot = self.links.index(x)
+            stretch = d / self.length - self.L0[slot]
+            if x.kind == "cable":
+                cols[f"{x.name}.taut"] = stretch > 0
+                stretch = np.maximum(stretch, 0.0)
+            cols[f"{x.name}.tension"] = force * self.k[slot] * stretch
         cols["energy"] = self._energies(
             np.stack([pts[p].real for p in self.every.points], axis=1) / self.length
         )

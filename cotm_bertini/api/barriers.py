@@ -12,15 +12,14 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..analysis.barriers import MAX_STEPS, PaperFlow, saddle_connections
+from ..analysis.barriers import MAX_STEPS, saddle_connections
 from ..columns import reference
 from ..errors import ParameterError
 from ..fs import atomic_write_text, new_folder, write_csv
 from ..model.framework.spec import Framework
+from ..motion.flows import flow_of
 from ..params import Params
 from .solutions import Solutions
-
-MATCH_POSE = 1e-7  # a framework's descent end this close (match coordinates) is that minimum
 
 BARRIERS_CSV = "barriers.csv"
 
@@ -95,39 +94,7 @@ def barriers(res: Solutions, max_steps: int = MAX_STEPS) -> Barriers:
     if isinstance(max_steps, bool) or not isinstance(max_steps, int | np.integer) or max_steps < 1:
         raise ParameterError(f"max_steps = {max_steps!r}: expected a whole number >= 1")
     t0 = time.perf_counter()
-    table, paths = saddle_connections(_flow(res), res.table, int(max_steps))
+    table, paths = saddle_connections(flow_of(res.params, res.table), res.table, int(max_steps))
     table = table.set_axis(pd.Index(table["saddle_id"].to_numpy(dtype=int)), axis=0)
     return Barriers(res.params, res.table, table, paths, time.perf_counter() - t0,
                     int(max_steps))  # fmt: skip
-
-
-def _flow(res: Solutions):
-    """The driver's model of the solve's mechanism."""
-    if isinstance(res.params, Params):
-        return PaperFlow(res.params, res.table)
-    from ..analysis.framework_flow import FrameworkFlow
-    from ..continuation.framework import pose_names
-
-    fw = res.params
-    return FrameworkFlow(fw, pose_names(fw), _matcher(fw, res.table))
-
-
-def _matcher(fw: Framework, table: pd.DataFrame):
-    """Which physical minimum of `table` a descent's end row is: the nearest in the sweeps'
-    match coordinates (cos, sin of angles, quaternions, positions and link lengths over the
-    length unit), if within MATCH_POSE."""
-    from ..continuation.framework import match_coordinates
-
-    phys = table[table.physical.astype(bool)]
-    minima = phys[phys.kind == "min"]
-    ref = match_coordinates(fw, minima.assign(point=0)).real if len(minima) else None
-
-    def match(rows: pd.DataFrame) -> int | None:
-        if ref is None:
-            return None
-        end = rows.assign(point=0, is_real=True, max_imag=0.0)
-        dist = np.abs(ref - match_coordinates(fw, end).real[0]).max(axis=1)
-        k = int(np.argmin(dist))
-        return int(minima.solution_id.iloc[k]) if dist[k] < MATCH_POSE else None
-
-    return match

@@ -303,6 +303,41 @@ def barriers(args: argparse.Namespace) -> int:
     return EXIT_INCOMPLETE if found.warnings else EXIT_OK
 
 
+def move(args: argparse.Namespace) -> int:
+    """`move`: solve at the path's start, follow the state along the path, write the run."""
+    from ..api.motion import move as follow_state
+    from ..api.solutions import solve as solve_params
+    from .options import path_from
+
+    path = path_from(args.path)
+    model, settings, label = params_from(args), settings_from(args), label_of(args)
+    values = model.as_dict()
+    for name, points in path.items():
+        given = name in values and any(t.partition("=")[0].strip() == name for t in args.set)
+        if given and values[name] != points[0]:
+            raise ParameterError(f"--set {name}={values[name]:g}, but --path {name} starts at "
+                                 f"{points[0]:g}: the move starts where the path does")  # fmt: skip
+    model = model.replace(**{n: p[0] for n, p in path.items() if n in values})
+    root = output_root(args.out) if args.out else Path("runs") / f"move-{label}"
+    output_root(root)
+    with silenced(args.quiet):
+        res = solve_params(model, settings, label=label)
+        found = follow_state(res, args.state, path, steps=args.steps, progress=not args.quiet)
+    folder = found.save(new_run_folder(root), plots=not args.no_plots)
+    link_latest(root, folder)
+    _warn(found.warnings)
+    along = ", ".join(f"{n} = {p}" for n, p in path.items())
+    print(f"{label} ({describe(model)}): state {args.state} followed along {along}: "
+          f"{len(found.snaps)} snaps")  # fmt: skip
+    if len(found.snaps):
+        cols = ["snap", *path, "kind", "released"]
+        print(found.snaps[cols].to_string(index=False))
+    ends = found.ends_in
+    print(f"ends in state {ends}" if ends is not None else "ends at the path's last waypoint")
+    print(_files_line(folder))
+    return EXIT_INCOMPLETE if found.warnings else EXIT_OK
+
+
 def _map_axes(args: argparse.Namespace, model) -> tuple[tuple, tuple]:
     """((x, (from, to)), (y, (from, to))) of `map`: the paper's free lengths (0 to 14 m by
     default), or two parameters of a framework, named with their ranges."""

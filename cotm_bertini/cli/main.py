@@ -146,6 +146,28 @@ def _map_parser(sub) -> None:
     m.set_defaults(run=commands.design_map, case=None)
 
 
+def _move_parser(sub) -> None:
+    m = sub.add_parser(
+        "move",
+        help="follow a stable state while parameters move: where it snaps, the energy released",
+        description="Solve at the path's start (the parameters with each path name at its first "
+        "waypoint), then follow the stable state --state (a solution_id as `solve` prints it) "
+        "along the path, piecewise linear; at a fold or a cable switch it snaps to the minimum "
+        "it falls into. Writes trajectory.csv, snaps.csv, run.json, move.png and move.gif.",
+    )
+    add_case(m)
+    add_params(m)
+    add_settings(m)
+    m.add_argument("--state", type=int, required=True, metavar="ID", help="a stable solution_id")
+    m.add_argument("--path", action="append", required=True, metavar="NAME=V0,V1,...",
+                   help="waypoints of one parameter (repeatable; as many for each)")  # fmt: skip
+    m.add_argument("--steps", type=int, default=100, help="recorded steps a segment (default 100)")
+    m.add_argument("--out", metavar="DIR", help="default runs/move-<label>")
+    m.add_argument("--no-plots", action="store_true", help="skip move.png/svg and move.gif")
+    m.add_argument("--quiet", action="store_true", help="no progress report")
+    m.set_defaults(run=commands.move)
+
+
 def _design_parser(sub) -> None:
     d = sub.add_parser(
         "design",
@@ -185,6 +207,7 @@ def _parser() -> argparse.ArgumentParser:
     pp.set_defaults(run=commands.paper)
     _barriers_parser(sub)
     _map_parser(sub)
+    _move_parser(sub)
     _design_parser(sub)
     pr = sub.add_parser(
         "params", help="print the parameter set the other commands would use, as TOML"

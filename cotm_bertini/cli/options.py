@@ -126,7 +126,7 @@ def overrides(args: argparse.Namespace) -> dict[str, float]:
 
 
 # The commands that take --framework; the others refuse it (the paper's mechanism only, so far).
-FRAMEWORK_COMMANDS = ("solve", "params", "sweep", "certify", "map", "barriers")
+FRAMEWORK_COMMANDS = ("solve", "params", "sweep", "certify", "map", "barriers", "move")
 
 
 def params_from(args: argparse.Namespace):
@@ -157,6 +157,24 @@ def framework_from(args: argparse.Namespace):
             raise ParameterError(f"--set {text!r}: expected NAME=VALUE")
         values[name.strip()] = value.strip()
     return fw.replace(**values)
+
+
+def path_from(texts: list[str]) -> dict[str, list[float]]:
+    """--path NAME=V0,V1,... (repeatable) as {name: [v0, v1, ...]}."""
+    path: dict[str, list[float]] = {}
+    for text in texts:
+        name, sep, values = text.partition("=")
+        name = name.strip()
+        try:
+            numbers = [float(v) for v in values.split(",")]
+        except ValueError:
+            numbers = []
+        if not sep or not name or not numbers:
+            raise ParameterError(f"--path {text!r}: expected NAME=V0,V1,... (numbers)")
+        if name in path:
+            raise ParameterError(f"--path {name}: given twice")
+        path[name] = numbers
+    return path
 
 
 def describe(params) -> str:

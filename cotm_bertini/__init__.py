@@ -36,6 +36,8 @@ _EXPORTS = {
     "Design": "cotm_bertini.analysis.design.free_lengths",
     "move": "cotm_bertini.api.motion",
     "Move": "cotm_bertini.api.motion",
+    "plan": "cotm_bertini.api.motion",
+    "Plan": "cotm_bertini.api.motion",
     "CertificateError": "cotm_bertini.errors",
     "CotmError": "cotm_bertini.errors",
     "ParameterError": "cotm_bertini.errors",

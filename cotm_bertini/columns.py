@@ -336,6 +336,13 @@ FRAMEWORK_MOVE = {
     "solutions.csv): > 0 at every step row, near 0 at a fold",
 }
 
+PLAN = {
+    "NAME (each of the map's two parameters)": "one row a waypoint of the actuator path, in "
+    "order: the first and the last are the solve's values (the actuators return), the others "
+    "grid points of the map where the path turns; cb.move along them (trajectory.csv, "
+    "snaps.csv here) ends in the goal state",
+}
+
 SNAPS = {
     "snap": "1, 2, ... along the move",
     "s": "path position where the followed state ends (its last located point)",
@@ -367,7 +374,7 @@ def reference(*tables: str, title: str = "Columns of the CSV files in this folde
     """The column reference of a run folder: 'solutions', 'counts', 'sweep', 'events',
     'barriers', 'folds', 'regions', 'design', 'framework', 'framework_counts',
     'framework_sweep', 'framework_events', 'framework_folds', 'framework_regions',
-    'framework_barriers', 'move', 'framework_move', 'snaps'."""
+    'framework_barriers', 'move', 'framework_move', 'snaps', 'plan'."""
     known = {
         "solutions": ("solutions.csv", SOLUTIONS),
         "counts": ("counts (run.json `counts`, `res.counts`)", COUNTS, "count"),
@@ -378,6 +385,7 @@ def reference(*tables: str, title: str = "Columns of the CSV files in this folde
         "move": ("trajectory.csv (`cb.move`)", MOVE),
         "framework_move": ("trajectory.csv of a framework's move", FRAMEWORK_MOVE),
         "snaps": ("snaps.csv", SNAPS),
+        "plan": ("plan.csv (`cb.plan`)", PLAN),
         "folds": ("folds.csv (`cb.fold_curves`)", FOLDS),
         "regions": ("regions.csv", REGIONS),
         "design": ("the design CSV (`cotm-bertini design --out`)", DESIGN),
@@ -414,5 +422,6 @@ def document() -> str:
         "move",
         "framework_move",
         "snaps",
+        "plan",
         title="Columns of the CSV files",
     )

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from conftest import run_cli
-from framework_physics import zeeman_energy
+from framework_physics import scan_critical_points, zeeman_energy
 from physics import energy as paper_energy
 
 import cotm_bertini as cb
@@ -270,3 +270,101 @@ def test_the_command_line_writes_the_run(tmp_path):
     bad = run_cli(*args, "--path", "y=-0.8,x", "--out", str(tmp_path / "b"))
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "--path" in bad.stderr
     assert not (tmp_path / "b").exists()
+
+
+# --- plans -------------------------------------------------------------------------------------
+
+WINDOW = ("x", (-0.6, 0.8), "y", (-0.8, 0.2))
+
+
+@pytest.fixture(scope="module")
+def zeeman_bistable():
+    """Zeeman's machine inside its bistable region, and a 21 x 21 map around it."""
+    fw = cb.Framework.from_toml(ROOT / "examples" / "zeeman.toml").replace(x=0.1, y=-0.25)
+    res = cb.solve(fw)
+    assert len(res.stable) == 2
+    return res, cb.design_map(fw, *WINDOW, points=21)
+
+
+def _simulate_waypoints(path, theta: float) -> tuple[float, int]:
+    """The independent quasi-static simulation along straight segments between waypoints (steps
+    of at most 1e-3 in x and y, a walk down V from the previous angle each): the final angle
+    and the number of jumps (over 0.3 rad in one step)."""
+    pts = path[["x", "y"]].to_numpy(float)
+    jumps = 0
+    theta = walk_down(lambda t: zeeman_energy(t, tuple(pts[0]), cables=False), theta)
+    for a, b in zip(pts[:-1], pts[1:], strict=True):
+        n = max(1, int(np.ceil(np.abs(b - a).max() / 1e-3)))
+        for k in range(1, n + 1):
+            u = tuple(a + k / n * (b - a))
+            new = walk_down(lambda t, u=u: zeeman_energy(t, u, cables=False), theta)
+            jumps += abs(new - theta) > 0.3
+            theta = new
+    return theta, jumps
+
+
+@pytest.mark.parametrize("order", [0, 1])
+def test_a_plan_between_zeeman_states_ends_in_the_goal(zeeman_bistable, order):
+    """From each stable state to the other: the path starts and ends at the solve's values, and
+    the independent simulation of its waypoints ends in the goal, with the move's snaps."""
+    res, dm = zeeman_bistable
+    a, b = (res.stable.solution_id.tolist())[:: 1 if order == 0 else -1]
+    pl = cb.plan(res, a, b, WINDOW, design_map=dm)
+    assert pl.status == "ok" and pl.move.ends_in == b
+    start = pl.path.iloc[0].to_dict()
+    assert start == {"x": 0.1, "y": -0.25} == pl.path.iloc[-1].to_dict()
+    angle = dict(
+        zip(res.stable.solution_id, np.radians(res.stable["wheel.angle_deg"]), strict=True)
+    )
+    end, jumps = _simulate_waypoints(pl.path, angle[a])
+    goal = walk_down(lambda t: zeeman_energy(t, (0.1, -0.25), cables=False), angle[b])
+    assert _deg_gap(np.degrees(end), np.degrees(goal)) < 1e-6
+    assert jumps == len(pl.move.snaps) == pl.record["snaps"]
+
+
+def test_a_window_inside_the_bistable_region_is_unreachable(zeeman_bistable):
+    """A small window around the start where, by independent scans of V at its corners and
+    centre, both stable states exist throughout: no plan, and the answer says so."""
+    res, _ = zeeman_bistable
+    window = ("x", (0.05, 0.15), "y", (-0.27, -0.23))
+    for u in [(0.05, -0.27), (0.05, -0.23), (0.15, -0.27), (0.15, -0.23), (0.1, -0.25)]:
+        kinds = [k for _, k in scan_critical_points(lambda t, u=u: zeeman_energy(t, u, False))]
+        assert kinds.count("min") == 2
+    a, b = res.stable.solution_id.tolist()
+    pl = cb.plan(res, a, b, window, points=5)
+    assert pl.status == "unreachable" and pl.move is None and pl.path.empty
+
+
+def test_plan_input_is_refused_in_one_line(zeeman_bistable):
+    res, dm = zeeman_bistable
+    a, b = res.stable.solution_id.tolist()
+    cases = [
+        ({"state": a, "goal": a, "over": WINDOW}, "already"),
+        ({"state": a, "goal": 99, "over": WINDOW}, "goal = 99"),
+        ({"state": a, "goal": b, "over": ("x", (0.2, 0.8), "y", (-0.8, 0.2))}, "outside"),
+        ({"state": a, "goal": b, "over": WINDOW, "design_map": dm, "points": 5}, "as it is"),
+        ({"state": a, "goal": b, "over": ("x", (-0.6, 0.7), "y", (-0.8, 0.2)), "design_map": dm},
+         "window"),
+    ]  # fmt: skip
+    for kwargs, message in cases:
+        with pytest.raises(cb.ParameterError, match=message) as err:
+            cb.plan(res, **kwargs)
+        assert "\n" not in str(err.value)
+
+
+def test_the_plan_command_writes_its_run(tmp_path):
+    """`plan` on the command line: the path, the move that checks it, the pictures."""
+    zeeman = str(ROOT / "examples" / "zeeman.toml")
+    done = run_cli("plan", "--framework", zeeman, "--set", "x=0.1", "--set", "y=-0.25",
+                   "--state", "1", "--goal", "2", "--param", "x", "--from", "-0.6", "--to", "0.8",
+                   "--param2", "y", "--from2", "-0.8", "--to2", "0.2", "--points", "11",
+                   "--workers", "1", "--quiet", "--out", str(tmp_path))  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    folder = tmp_path / "latest"
+    names = {p.name for p in folder.iterdir()}
+    assert names >= {"plan.csv", "trajectory.csv", "snaps.csv", "run.json", "plan.png",
+                     "move.png", "move.gif", "columns.md"}  # fmt: skip
+    record = json.loads((folder / "run.json").read_text())
+    assert record["status"] == "ok" and record["move_ends_in"] == 2
+    plan_csv = (folder / "plan.csv").read_text().splitlines()
+    assert plan_csv[0] == "x,y" and plan_csv[1] == plan_csv[-1] == "0.1,-0.25"

@@ -60,6 +60,7 @@ class Flow(Protocol):
     def shortest(self, x: np.ndarray) -> float: ...
     def cable_gap(self, x: np.ndarray) -> float: ...
     def rows(self, path: np.ndarray) -> pd.DataFrame: ...
+    def columns(self, path: np.ndarray) -> dict[str, np.ndarray]: ...
     def match(self, end: np.ndarray) -> int | None: ...
     def record(self, path: np.ndarray) -> object: ...
 
@@ -236,12 +237,15 @@ class PaperFlow:
 
     def rows(self, path: np.ndarray) -> pd.DataFrame:
         """States as solutions.csv-style rows: the angles (deg, wrapped), d1, d2 (m), V (J)."""
+        return pd.DataFrame(self.columns(path))
+
+    def columns(self, path: np.ndarray) -> dict[str, np.ndarray]:
+        """The columns of `rows`, as numpy arrays."""
         path = np.atleast_2d(path)
         d = generalised_forces(self.params, path[:, 0], path[:, 1])[1]
         deg = wrap_degrees(np.degrees(path))
-        return pd.DataFrame({"gamma1_deg": deg[:, 0], "gamma2_deg": deg[:, 1],
-                             "d1": d[0], "d2": d[1],
-                             "energy": [self.energy(x) for x in path]})  # fmt: skip
+        return {"gamma1_deg": deg[:, 0], "gamma2_deg": deg[:, 1], "d1": d[0], "d2": d[1],
+                "energy": np.array([self.energy(x) for x in path])}  # fmt: skip
 
     def match(self, end: np.ndarray) -> int | None:
         """The solution_id of the minimum the descent ended at (None: not a listed minimum)."""

@@ -61,6 +61,7 @@ class FrameworkFlow:
         self.index = {p: k for k, p in enumerate(self.every.points)}
         self.ends = (np.array([self.index[x.a] for x in self.links], dtype=int),
                      np.array([self.index[x.b] for x in self.links], dtype=int))  # fmt: skip
+        self._systems: dict[tuple[str, ...], object] = {}  # shared by the copies `at` makes
         self._values(fw)
 
     def _values(self, fw: Framework) -> None:
@@ -175,7 +176,9 @@ class FrameworkFlow:
         lengths = self._lengths(self._coords(x))
         taut = tuple(link.name for link, d, L0 in zip(self.links, lengths, self.L0, strict=True)
                      if link.kind == "cable" and d > L0)  # fmt: skip
-        fs = framework_system(self.fw, taut)
+        fs = self._systems.get(taut)
+        if fs is None:  # one lookup a taut set (the structure key costs more than the rest)
+            fs = self._systems[taut] = framework_system(self.fw, taut)
         if fs.free:
             return np.zeros(0), np.zeros((self.m, 0))
         X = self._full(x, len(fs.ps.variables))
@@ -262,6 +265,10 @@ class FrameworkFlow:
     def rows(self, path: np.ndarray) -> pd.DataFrame:
         """States as solutions.csv-style rows: pose columns, every link's length, each spring's
         and cable's tension (and whether a cable is taut), V (J)."""
+        return pd.DataFrame(self.columns(path))
+
+    def columns(self, path: np.ndarray) -> dict[str, np.ndarray]:
+        """The columns of `rows`, as numpy arrays."""
         X = self._full(path)
         var = {name: X[:, k] for k, name in enumerate(self.every.ps.variables)}
         pts = positions(self.every, X, self.P, self.fw.dim, self.length)
@@ -281,7 +288,7 @@ class FrameworkFlow:
         cols["energy"] = self._energies(
             np.stack([pts[p].real for p in self.every.points], axis=1) / self.length
         )
-        return pd.DataFrame(cols)
+        return cols
 
     def match(self, end: np.ndarray) -> int | None:
         """The solution_id of the minimum the descent ended at (None: not a listed minimum)."""

@@ -338,6 +338,44 @@ def move(args: argparse.Namespace) -> int:
     return EXIT_INCOMPLETE if found.warnings else EXIT_OK
 
 
+def plan(args: argparse.Namespace) -> int:
+    """`plan`: solve, map the window, find and check the path from --state to --goal."""
+    from ..api.motion import plan as find_plan
+    from ..api.solutions import solve as solve_params
+
+    model, settings, label = params_from(args), settings_from(args), label_of(args)
+    (x, xr), (y, yr) = _map_axes(args, model)
+    workers = _workers(args)
+    root = output_root(args.out) if args.out else Path("runs") / f"plan-{label}"
+    output_root(root)
+    with silenced(args.quiet):
+        res = solve_params(model, settings, label=label)
+        found = find_plan(res, args.state, args.goal, (x, xr, y, yr), points=args.points,
+                          settings=settings, workers=workers, progress=not args.quiet)  # fmt: skip
+    folder = found.save(new_run_folder(root), plots=not args.no_plots)
+    link_latest(root, folder)
+    print(f"{label} ({describe(model)}): from state {args.state} to {args.goal} over {x} "
+          f"{xr[0]:g}..{xr[1]:g}, {y} {yr[0]:g}..{yr[1]:g}: {found.status}")  # fmt: skip
+    if found.status == "unreachable":
+        print("unreachable within the window: no path over its grid ends in the goal")
+    else:
+        print(found.path.to_string(index=False))
+        print(f"{found.record['snaps']} snaps on the way; the move along it ends in state "
+              f"{found.record['move_ends_in']}")  # fmt: skip
+    print(_files_line(folder))
+    return EXIT_INCOMPLETE if found.status == "incomplete" else EXIT_OK
+
+
+def _workers(args: argparse.Namespace) -> int:
+    """--workers, or one per core; refused below 1."""
+    from ..continuation.runner import default_workers
+
+    workers = default_workers() if args.workers is None else args.workers
+    if workers < 1:
+        raise ParameterError(f"--workers {workers}: must be >= 1")
+    return workers
+
+
 def _map_axes(args: argparse.Namespace, model) -> tuple[tuple, tuple]:
     """((x, (from, to)), (y, (from, to))) of `map`: the paper's free lengths (0 to 14 m by
     default), or two parameters of a framework, named with their ranges."""
@@ -381,14 +419,11 @@ def design_map(args: argparse.Namespace) -> int:
     lengths, or any two of a framework's)."""
     from ..api.maps import SWEEP_FOLDER
     from ..api.maps import design_map as make_map
-    from ..continuation.runner import default_workers
     from ..params import Params
 
     model = params_from(args)
     (x, xr), (y, yr) = _map_axes(args, model)
-    workers = default_workers() if args.workers is None else args.workers
-    if workers < 1:
-        raise ParameterError(f"--workers {workers}: must be >= 1")
+    workers = _workers(args)
     if args.points < 2:
         raise ParameterError(f"--points {args.points}: a map needs at least 2 points a side")
     root = output_root(args.out)

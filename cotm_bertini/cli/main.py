@@ -122,6 +122,19 @@ def _barriers_parser(sub) -> None:
     b.set_defaults(run=commands.barriers)
 
 
+def _window_options(p, points: int) -> None:
+    """The two axes of a map (or a plan's map) and their ranges, points, workers."""
+    p.add_argument("--param", help="first axis (default L01; a framework: one of its parameters)")
+    p.add_argument("--from", dest="start", type=float, help="default 0 (the paper)")
+    p.add_argument("--to", dest="stop", type=float, help="default 14 (the paper)")
+    p.add_argument("--param2", help="second axis (default L02)")
+    p.add_argument("--from2", dest="start2", type=float, help="default 0 (the paper)")
+    p.add_argument("--to2", dest="stop2", type=float, help="default 14 (the paper)")
+    p.add_argument("--points", type=int, default=points,
+                   help=f"grid points a side (default {points})")  # fmt: skip
+    p.add_argument("--workers", type=int, help="local processes (default: one per core)")
+
+
 def _map_parser(sub) -> None:
     m = sub.add_parser(
         "map",
@@ -132,14 +145,7 @@ def _map_parser(sub) -> None:
     )
     add_params(m)
     add_settings(m)
-    m.add_argument("--param", help="first axis (default L01; a framework: one of its parameters)")
-    m.add_argument("--from", dest="start", type=float, help="default 0 (the paper)")
-    m.add_argument("--to", dest="stop", type=float, help="default 14 (the paper)")
-    m.add_argument("--param2", help="second axis (default L02)")
-    m.add_argument("--from2", dest="start2", type=float, help="default 0 (the paper)")
-    m.add_argument("--to2", dest="stop2", type=float, help="default 14 (the paper)")
-    m.add_argument("--points", type=int, default=101, help="grid points a side (default 101)")
-    m.add_argument("--workers", type=int, help="local processes (default: one per core)")
+    _window_options(m, points=101)
     m.add_argument("--out", metavar="DIR", default="runs/map", help="default runs/map")
     m.add_argument("--no-plots", action="store_true", help="skip map.png/svg")
     m.add_argument("--quiet", action="store_true", help="no progress report")
@@ -166,6 +172,28 @@ def _move_parser(sub) -> None:
     m.add_argument("--no-plots", action="store_true", help="skip move.png/svg and move.gif")
     m.add_argument("--quiet", action="store_true", help="no progress report")
     m.set_defaults(run=commands.move)
+
+
+def _plan_parser(sub) -> None:
+    p = sub.add_parser(
+        "plan",
+        help="an actuator path from one stable state to another, over a map",
+        description="Solve at the parameters, make the map over the window (as `map`), then "
+        "find the path over its grid with the fewest snaps, then the least travel, that takes "
+        "the mechanism from --state to --goal and brings the actuators back; checked by a "
+        "move along it. Writes plan.csv, the move's trajectory.csv and snaps.csv, run.json, "
+        "plan.png, move.png, move.gif. 'unreachable' (exit 0) is an answer.",
+    )
+    add_case(p)
+    add_params(p)
+    add_settings(p)
+    p.add_argument("--state", type=int, required=True, metavar="ID", help="a stable solution_id")
+    p.add_argument("--goal", type=int, required=True, metavar="ID", help="another stable one")
+    _window_options(p, points=41)
+    p.add_argument("--out", metavar="DIR", help="default runs/plan-<label>")
+    p.add_argument("--no-plots", action="store_true", help="skip plan.png, move.png, move.gif")
+    p.add_argument("--quiet", action="store_true", help="no progress report")
+    p.set_defaults(run=commands.plan)
 
 
 def _design_parser(sub) -> None:
@@ -208,6 +236,7 @@ def _parser() -> argparse.ArgumentParser:
     _barriers_parser(sub)
     _map_parser(sub)
     _move_parser(sub)
+    _plan_parser(sub)
     _design_parser(sub)
     pr = sub.add_parser(
         "params", help="print the parameter set the other commands would use, as TOML"

@@ -126,7 +126,7 @@ def overrides(args: argparse.Namespace) -> dict[str, float]:
 
 
 # The commands that take --framework; the others refuse it (the paper's mechanism only, so far).
-FRAMEWORK_COMMANDS = ("solve", "params", "sweep", "certify", "map", "barriers", "move")
+FRAMEWORK_COMMANDS = ("solve", "params", "sweep", "certify", "map", "barriers", "move", "plan")
 
 
 def params_from(args: argparse.Namespace):

@@ -118,3 +118,25 @@ def _frame(ax, move, row: pd.Series) -> None:
         _draw(ax, model, row)
         if row.event != "step":
             ax.set_facecolor(SNAP_BACKGROUND)
+
+
+def plot_plan(plan, path: str | Path) -> list[Path]:
+    """The map (regions, fold curves) with the plan's path over it, its snaps marked."""
+    from .design_map import map_figure
+
+    dm = plan.map
+    fig = map_figure(plan.params, dm.regions, dm.folds, dm.axes)
+    ax = fig.axes[0]
+    x, y = dm.axes
+    if len(plan.path):
+        ax.plot(plan.path[x], plan.path[y], "-o", color="black", lw=2.0, ms=4, zorder=6,
+                label="plan")  # fmt: skip
+        ax.plot(plan.path[x].iloc[:1], plan.path[y].iloc[:1], "*", color="gold", ms=16,
+                mec="black", zorder=7, label="start and end")  # fmt: skip
+    if plan.move is not None and len(plan.move.snaps):
+        snaps = plan.move.snaps
+        ax.plot(snaps[x], snaps[y], "X", color="tab:red", ms=11, mec="white", zorder=8,
+                label="snaps")  # fmt: skip
+    ax.legend(loc="best", fontsize=8)
+    set_title(fig, f"plan from state #{plan.state} to #{plan.goal}: {plan.status}", fontsize=10)
+    return save(fig, path)

@@ -348,8 +348,9 @@ SNAPS = {
     "s": "path position where the followed state ends (its last located point)",
     "NAME (each path parameter)": "its value there",
     "kind": "fold (the softest Hessian eigenvalue fell below 1e-3, normalised), cable_switch (a "
-    "cable within 1e-6 length units of its free length: V is piecewise there) or unexplained "
-    "(neither: reported as a warning)",
+    "cable within 1e-6 length units of its free length: V is piecewise there), unexplained "
+    "(neither), or degenerate (the descent ended within 1e-4 of where it began: a cusp or a "
+    "pitchfork on the path, the branch taken not the model's to say); the last two are warnings",
     "released": "V(state before) - V(minimum after), both at the parameter values just past the "
     "end (J, or the file's units of k length^2)",
     "located_to": "the width of the final bracket of the end, in the path's parameters (the "

@@ -368,3 +368,53 @@ def test_the_plan_command_writes_its_run(tmp_path):
     assert record["status"] == "ok" and record["move_ends_in"] == 2
     plan_csv = (folder / "plan.csv").read_text().splitlines()
     assert plan_csv[0] == "x,y" and plan_csv[1] == plan_csv[-1] == "0.1,-0.25"
+
+
+# --- a degenerate point on the path ------------------------------------------------------------
+
+
+class _Quartic:
+    """V = t^4/4 - a t^2/2 (one angle t, parameter a): a pitchfork at a = 0, where the minimum
+    t = 0 becomes a maximum between two new minima at +-sqrt(a)."""
+
+    newton_tol, zero_length, length_unit, hessian_unit = 1e-13, 0.0, 1.0, 1.0
+
+    def __init__(self, a: float):
+        self.a = a
+
+    def energy(self, x):
+        return float(x[0] ** 4 / 4 - self.a * x[0] ** 2 / 2)
+
+    def gradient(self, x):
+        return np.array([x[0] ** 3 - self.a * x[0]])
+
+    def eigh(self, x):
+        return np.array([3 * x[0] ** 2 - self.a]), np.eye(1)
+
+    def newton(self, x, grad):
+        h = 3 * x[0] ** 2 - self.a
+        return None if h <= 0 else -grad / h
+
+    def move(self, x, step):
+        return x + step
+
+    def shortest(self, x):
+        return np.inf
+
+    def cable_gap(self, x):
+        return np.inf
+
+
+def test_a_pitchfork_on_the_path_is_reported_not_chosen():
+    """Through a = 0 the state at t = 0 goes on without falling; the follower says so (kind
+    degenerate, a warning) instead of calling it a fold."""
+    from cotm_bertini.motion.follow import follow
+    from cotm_bertini.motion.path import actuator_path
+
+    path = actuator_path({"a": [-1.0, 1.0]}, {"a": -1.0})
+    f = follow(lambda v: _Quartic(v["a"]), path, np.array([0.05]), 20)
+    # Newton converges only linearly at the degenerate minimum (V ~ t^4), so the state may be
+    # reported at the last step before a = 0 as well as at it: each report says degenerate.
+    assert f.snaps and all(sn.kind == "degenerate" and abs(sn.s - 0.5) < 1e-9 for sn in f.snaps)
+    assert len(f.warnings) == len(f.snaps) and all("pitchfork" in w for w in f.warnings)
+    assert abs(abs(f.states[-1][0]) - 1.0) < 1e-12  # on one of the two new minima, sqrt(1)

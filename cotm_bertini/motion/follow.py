@@ -11,7 +11,10 @@ cable switch if a cable is within SWITCH_GAP of its free length (V is piecewise;
 crosses a switch smoothly is followed through it), else unexplained (reported). The snap: just
 past the end, a kick of KICK along the softest eigenvector, to the side of lower energy, then
 gradient flow (analysis/barriers.descend) to the minimum the state falls into. A descent that
-ends nowhere (no minimum within its steps) ends the move, reported, never guessed.
+ends nowhere (no minimum within its steps) ends the move; one that ends within SAME_STATE of
+where it began (`degenerate`: a cusp or a pitchfork on the path, where the state goes on without
+falling but which branch it takes is not the model's to say) goes on with a warning: reported,
+never guessed.
 """
 
 from __future__ import annotations
@@ -33,6 +36,14 @@ LOCATE = 1e-10  # path position: a state's end is located to this
 FOLD_EIG = 1e-3  # softest normalised eigenvalue at an end below this: a fold
 SWITCH_GAP = 1e-6  # |d - L0| under this (length units) at an end: a cable switch
 KICK = 1e-3  # the first step off a fold along its soft direction (local coordinates)
+SAME_STATE = 1e-4  # a descent ending this close to where the state ended fell nowhere
+
+
+WARNINGS = {
+    "unexplained": "with neither a soft Hessian nor a cable at its switch",
+    "degenerate": "at a singular point it passes without falling (a cusp or a pitchfork on the "
+    "path): it goes on to the minimum next to it, a branch the model does not choose",
+}
 
 
 @dataclass(frozen=True)
@@ -126,11 +137,9 @@ def follow(
                         f"minimum within {snap.descent_steps} descent steps: the move stops there"
                     )
                     return out
-                if snap.kind == "unexplained":
-                    out.warnings.append(
-                        f"the state ended at path position {s:.10g} ({_values(path, s)}) with "
-                        f"neither a soft Hessian nor a cable at its switch"
-                    )
+                if snap.kind in WARNINGS:
+                    out.warnings.append(f"the state ended at path position {s:.10g} "
+                                        f"({_values(path, s)}) {WARNINGS[snap.kind]}")  # fmt: skip
                 x, s, h = snap.after, s + h, float(grid[1])
                 out.add(s, x, "snap_to")
             out.add(target, x, "step")
@@ -161,4 +170,6 @@ def _snap(flow_at, path: ActuatorPath, s: float, s_after: float, x: np.ndarray) 
     d = descend(after, start)
     end = d.path[-1] if d.converged else None
     released = after.energy(x) - after.energy(end) if end is not None else float("nan")
+    if end is not None and float(np.abs(end - x).max()) < SAME_STATE:
+        kind = "degenerate"  # it fell nowhere: a cusp or a pitchfork on the path
     return Snap(s, s_after, kind, np.array(x), end, released, softest, gap, len(d.path) - 1)

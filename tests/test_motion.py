@@ -320,6 +320,7 @@ def test_a_plan_between_zeeman_states_ends_in_the_goal(zeeman_bistable, order):
     goal = walk_down(lambda t: zeeman_energy(t, (0.1, -0.25), cables=False), angle[b])
     assert _deg_gap(np.degrees(end), np.degrees(goal)) < 1e-6
     assert jumps == len(pl.move.snaps) == pl.record["snaps"]
+    assert cb.move(res, a, pl.path).ends_in == b  # the plan's table is a path as it is
 
 
 def test_a_window_inside_the_bistable_region_is_unreachable(zeeman_bistable):

@@ -38,7 +38,10 @@ class ActuatorPath:
 def actuator_path(path: Mapping[str, Sequence[float]], known: Mapping[str, float]) -> ActuatorPath:
     """The path {name: [v0, v1, ...]} checked against the model's parameter values `known`
     (names known, numbers finite, the same number of waypoints >= 2 for every name, the
-    first waypoint at the model's values); a one-line ParameterError otherwise."""
+    first waypoint at the model's values); a one-line ParameterError otherwise. A table (a plan's
+    `path`: a column a parameter, a row a waypoint) is read as {column: its values}."""
+    if hasattr(path, "columns") and hasattr(path, "to_dict"):
+        path = {str(c): path[c].tolist() for c in path.columns}
     if not isinstance(path, Mapping) or not path:
         raise ParameterError(f"path = {path!r}: expected {{name: [v0, v1, ...]}} with a name")
     columns, size = [], None

@@ -5,7 +5,7 @@ BIN     := $(VENV)/bin
 STAMP   := $(VENV)/.installed
 CLI     := $(BIN)/cotm-bertini
 
-.PHONY: install phcpack case1 case2 case3 test stress sweep map bench verify paper lint format clean-runs
+.PHONY: install phcpack browser case1 case2 case3 test stress sweep map explore bench verify paper lint format clean-runs
 
 $(STAMP): pyproject.toml
 	@$(PY) -c 'import venv, ensurepip' 2>/dev/null || { \
@@ -23,6 +23,12 @@ phcpack:
 	  echo "installing Debian phcpack"; \
 	  apt-get update -qq && apt-get install -y -qq phcpack >/dev/null; }
 
+# Debian's Chromium and its driver: the explorer pages' browser tests (tests/test_explore.py).
+browser:
+	@command -v chromium >/dev/null && command -v chromedriver >/dev/null || { \
+	  echo "installing Debian chromium and chromium-driver"; \
+	  apt-get update -qq && apt-get install -y -qq chromium chromium-driver >/dev/null; }
+
 # The cli engine keeps Bertini's own output files in the run folder for inspection;
 # `cotm-bertini solve` without --engine uses the faster in-process parameter homotopy.
 case1 case2 case3: $(STAMP)
@@ -30,7 +36,7 @@ case1 case2 case3: $(STAMP)
 
 # Two pytest-xdist workers (the CI machine's 2 cores); the costly framework examples share one
 # worker (xdist_group) and every worker one fresh cache, so each generic set is solved once.
-test: $(STAMP) phcpack
+test: $(STAMP) phcpack browser
 	$(BIN)/pytest -q -m "not slow" -n 2 --dist loadgroup
 
 verify: $(STAMP) phcpack
@@ -46,6 +52,10 @@ sweep: $(STAMP)
 # The design map of the paper geometry: stable-count regions (101 x 101 solves) and fold curves.
 map: $(STAMP)
 	$(CLI) map --param L01 --from 0 --to 14 --param2 L02 --from2 0 --to2 14 --points 101
+
+# The same map with its explorer page: runs/map/latest/explore.html, opened from disk.
+explore: $(STAMP)
+	$(CLI) map --param L01 --from 0 --to 14 --param2 L02 --from2 0 --to2 14 --points 101 --html
 
 # The full stress set (200 random geometries, 20 seeds); `make test` runs a fast subset.
 stress: $(STAMP) phcpack

@@ -20,3 +20,16 @@ def template_texts() -> dict[str, str]:
     except (ModuleNotFoundError, FileNotFoundError, NotADirectoryError):
         folder = Path(__file__).resolve().parent.parent / "templates"
         return {name: (folder / name).read_text() for name in TEMPLATE_NAMES}
+
+
+PAGE_NAMES = ("explore.html.j2",)  # page templates: not part of any solve's cache key
+
+
+def page_template(name: str) -> str:
+    """A page template's text (the explorer's), from the installed package or a checkout."""
+    if name not in PAGE_NAMES:
+        raise KeyError(name)
+    try:
+        return resources.files("cotm_bertini.templates").joinpath(name).read_text()
+    except (ModuleNotFoundError, FileNotFoundError, NotADirectoryError):
+        return (Path(__file__).resolve().parent.parent / "templates" / name).read_text()

@@ -258,12 +258,13 @@ def test_the_command_line_writes_the_run(tmp_path):
     """`move` solves at the path's start, follows, writes the run folder; a bad path: exit 2."""
     zeeman = str(ROOT / "examples" / "zeeman.toml")
     args = ["move", "--framework", zeeman, "--set", "x=0.1", "--state", "1", "--quiet"]
-    done = run_cli(*args, "--path", "y=-0.8,0.2,-0.8", "--steps", "20", "--out", str(tmp_path))
+    done = run_cli(*args, "--path", "y=-0.8,0.2,-0.8", "--steps", "20", "--out", str(tmp_path),
+                   "--html")  # fmt: skip
     assert done.returncode == 0, done.stderr
     folder = tmp_path / "latest"
     names = {p.name for p in folder.iterdir()}
     assert names >= {"trajectory.csv", "snaps.csv", "run.json", "columns.md", "move.png",
-                     "move.gif"}  # fmt: skip
+                     "move.gif", "explore.html"}  # fmt: skip
     record = json.loads((folder / "run.json").read_text())
     assert record["snaps"] == 2 and record["ends_in"] == 1 and record["status"] == "ok"
     assert record["path"] == {"y": [-0.8, 0.2, -0.8]} and record["params"]["y"] == -0.8

@@ -57,10 +57,17 @@ class DesignMap:
 
         return plot_map(self.params, self.regions, self.folds, path, self.axes)
 
-    def save(self, folder: str | Path, plots: bool = True) -> Path:
-        """folds.csv, regions.csv, columns.md, run.json [, map.png/svg] and sweep/ (the 2-D
-        sweep behind regions.csv, hard-linked from where it was solved) in a new folder, built
-        under a hidden name and renamed when complete."""
+    def explore(self, path: str | Path) -> Path:
+        """explore.html: the map in a browser, offline; a click on a grid point draws its
+        equilibria (from the map's 2-D sweep)."""
+        from ..plot.explore_pages import map_page
+
+        return map_page(self, path)
+
+    def save(self, folder: str | Path, plots: bool = True, html: bool = False) -> Path:
+        """folds.csv, regions.csv, columns.md, run.json [, map.png/svg] [, explore.html] and
+        sweep/ (the 2-D sweep behind regions.csv, hard-linked from where it was solved) in a
+        new folder, built under a hidden name and renamed when complete."""
         source = Path(self.record["sweep_folder"])
         tables = ("folds", "regions") if isinstance(self.params, Params) else MAP_TABLES
         with new_folder(folder) as work:
@@ -69,6 +76,8 @@ class DesignMap:
             atomic_write_text(work / "columns.md", reference(*tables))
             if plots:
                 self.plot(work / "map")
+            if html:
+                self.explore(work / "explore.html")
             link_tree(source, work / SWEEP_FOLDER)
             record = {**self.record, "sweep_folder": SWEEP_FOLDER, "sweep_solved_in": str(source)}
             write_json(work / "run.json", record)

@@ -69,9 +69,15 @@ class Move:
 
         return animate_move(self, path, frames)
 
-    def save(self, folder: str | Path, plots: bool = True) -> Path:
-        """trajectory.csv, snaps.csv, columns.md, run.json [, move.png/svg, move.gif] in a new
-        folder, built under a hidden name and renamed when complete."""
+    def explore(self, path: str | Path) -> Path:
+        """explore.html: the move in a browser, offline, a slider along its steps."""
+        from ..plot.explore_pages import move_page
+
+        return move_page(self, path)
+
+    def save(self, folder: str | Path, plots: bool = True, html: bool = False) -> Path:
+        """trajectory.csv, snaps.csv, columns.md, run.json [, move.png/svg, move.gif]
+        [, explore.html] in a new folder, built under a hidden name and renamed when complete."""
         tables = ("move", "snaps") if isinstance(self.params, Params) else (
             "framework_move", "snaps")  # fmt: skip
         with new_folder(folder) as work:
@@ -82,6 +88,8 @@ class Move:
             if plots:
                 self.plot(work / "move")
                 self.animate(work / "move.gif")
+            if html:
+                self.explore(work / "explore.html")
         return Path(folder)
 
 
@@ -218,9 +226,16 @@ class Plan:
 
         return plot_plan(self, path)
 
-    def save(self, folder: str | Path, plots: bool = True) -> Path:
-        """plan.csv, run.json, columns.md [, plan.png/svg] and the checking move's
-        trajectory.csv, snaps.csv [, move.png/svg, move.gif], in a new folder."""
+    def explore(self, path: str | Path) -> Path:
+        """explore.html: the plan's map in a browser, offline, with the path drawn on it."""
+        from ..plot.explore_pages import map_page
+
+        return map_page(self.map, path, overlay=self.path)
+
+    def save(self, folder: str | Path, plots: bool = True, html: bool = False) -> Path:
+        """plan.csv, run.json, columns.md [, plan.png/svg] [, explore.html: the map with the
+        path] and the checking move's trajectory.csv, snaps.csv [, move.png/svg, move.gif],
+        in a new folder."""
         with new_folder(folder) as work:
             write_csv(work / "plan.csv", self.path)
             if self.move is not None:
@@ -234,6 +249,8 @@ class Plan:
                 if self.move is not None:
                     self.move.plot(work / "move")
                     self.move.animate(work / "move.gif")
+            if html:
+                self.explore(work / "explore.html")
         return Path(folder)
 
 

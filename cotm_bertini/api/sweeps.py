@@ -64,6 +64,19 @@ class Sweep:
         """'ok', or 'incomplete' when some point's completeness check failed."""
         return self.record["status"]
 
+    def explore(self, path: str | Path | None = None) -> Path:
+        """explore.html (default: in the sweep folder): the bifurcation diagram in a browser,
+        offline, with a slider that draws the equilibria at each point (one-parameter sweeps;
+        a two-parameter sweep is explored through its map, cb.DesignMap.explore)."""
+        from ..plot.explore_pages import sweep_page
+
+        if self.spec.param2 is not None:
+            raise ParameterError("explore: a two-parameter sweep is explored as a map "
+                                 "(cb.design_map(...).explore)")  # fmt: skip
+        model = self.spec.model if self.spec.framework is not None else Params(**self.spec.base)
+        path = Path(path) if path is not None else self.folder / "explore.html"
+        return sweep_page(model, self.table, self.spec.param, self.spec.values, path)
+
     def plot(self, path: str | Path | None = None, show_all: bool = False) -> list[Path]:
         """The bifurcation diagram (1-D) or the stable-count map (2-D).
 

@@ -158,6 +158,8 @@ def sweep(args: argparse.Namespace) -> int:
     if isinstance(workers, int) and workers < 1:
         raise ParameterError(f"--workers {workers}: must be >= 1")
     progress = not args.quiet
+    if args.html and args.param2:
+        raise ParameterError("--html: a two-parameter sweep is explored as a map (`map --html`)")
     if args.resume and not (Path(args.resume) / SPEC_FILE).is_file():
         raise ParameterError(f"--resume {args.resume!r}: not a sweep folder (no {SPEC_FILE})")
     if args.resume:
@@ -176,6 +178,8 @@ def sweep(args: argparse.Namespace) -> int:
                 certify=args.certify,
             )  # fmt: skip
     figures = [] if args.no_plots else sw.plot(show_all=args.all)
+    if args.html:
+        figures.append(sw.explore())
     rec, stats = sw.record, sw.record["stats"]
     print(
         f"{rec['rows']} rows at {rec['points']} points ({stats['skipped']} resumed), "
@@ -323,7 +327,7 @@ def move(args: argparse.Namespace) -> int:
     with silenced(args.quiet):
         res = solve_params(model, settings, label=label)
         found = follow_state(res, args.state, path, steps=args.steps, progress=not args.quiet)
-    folder = found.save(new_run_folder(root), plots=not args.no_plots)
+    folder = found.save(new_run_folder(root), plots=not args.no_plots, html=args.html)
     link_latest(root, folder)
     _warn(found.warnings)
     along = ", ".join(f"{n} = {p}" for n, p in path.items())
@@ -352,7 +356,7 @@ def plan(args: argparse.Namespace) -> int:
         res = solve_params(model, settings, label=label)
         found = find_plan(res, args.state, args.goal, (x, xr, y, yr), points=args.points,
                           settings=settings, workers=workers, progress=not args.quiet)  # fmt: skip
-    folder = found.save(new_run_folder(root), plots=not args.no_plots)
+    folder = found.save(new_run_folder(root), plots=not args.no_plots, html=args.html)
     link_latest(root, folder)
     print(f"{label} ({describe(model)}): from state {args.state} to {args.goal} over {x} "
           f"{xr[0]:g}..{xr[1]:g}, {y} {yr[0]:g}..{yr[1]:g}: {found.status}")  # fmt: skip
@@ -432,7 +436,7 @@ def design_map(args: argparse.Namespace) -> int:
             model, x, xr, y, yr, points=args.points, settings=settings_from(args),
             workers=workers, progress=not args.quiet,
         )  # fmt: skip
-    folder = found.save(new_run_folder(root), plots=not args.no_plots)
+    folder = found.save(new_run_folder(root), plots=not args.no_plots, html=args.html)
     link_latest(root, folder)
     counts = found.regions.stable.value_counts().sort_index()
     spread = ", ".join(f"{n} stable: {c} points" for n, c in counts.items())

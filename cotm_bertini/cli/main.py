@@ -31,6 +31,9 @@ def _version_text() -> str:
     return f"cotm-bertini {__version__} (bertini2 {bertini2_version()})"
 
 
+HTML_HELP = "also write explore.html: the results in a browser, offline, one file"
+
+
 def _solve_parser(sub) -> None:
     s = sub.add_parser("solve", help="every equilibrium of one parameter set")
     add_case(s)
@@ -96,6 +99,7 @@ def _sweep_parser(sub) -> None:
     w.add_argument("--resume", metavar="DIR", help="continue the sweep stored in DIR")
     w.add_argument("--all", action="store_true", help="plot the non-physical real roots too")
     w.add_argument("--no-plots", action="store_true", help="skip the figures")
+    w.add_argument("--html", action="store_true", help=HTML_HELP + " (one-parameter sweeps)")
     w.add_argument("--quiet", action="store_true", help="no progress report")
     w.add_argument(
         "--certify", action="store_true", help="prove every point (docs/certify.md); slower"
@@ -148,6 +152,7 @@ def _map_parser(sub) -> None:
     _window_options(m, points=101)
     m.add_argument("--out", metavar="DIR", default="runs/map", help="default runs/map")
     m.add_argument("--no-plots", action="store_true", help="skip map.png/svg")
+    m.add_argument("--html", action="store_true", help=HTML_HELP)
     m.add_argument("--quiet", action="store_true", help="no progress report")
     m.set_defaults(run=commands.design_map, case=None)
 
@@ -170,6 +175,7 @@ def _move_parser(sub) -> None:
     m.add_argument("--steps", type=int, default=100, help="recorded steps a segment (default 100)")
     m.add_argument("--out", metavar="DIR", help="default runs/move-<label>")
     m.add_argument("--no-plots", action="store_true", help="skip move.png/svg and move.gif")
+    m.add_argument("--html", action="store_true", help=HTML_HELP)
     m.add_argument("--quiet", action="store_true", help="no progress report")
     m.set_defaults(run=commands.move)
 
@@ -192,6 +198,7 @@ def _plan_parser(sub) -> None:
     _window_options(p, points=41)
     p.add_argument("--out", metavar="DIR", help="default runs/plan-<label>")
     p.add_argument("--no-plots", action="store_true", help="skip plan.png, move.png, move.gif")
+    p.add_argument("--html", action="store_true", help=HTML_HELP)
     p.add_argument("--quiet", action="store_true", help="no progress report")
     p.set_defaults(run=commands.plan)
 

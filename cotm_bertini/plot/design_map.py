@@ -63,14 +63,31 @@ def map_figure(
     return fig
 
 
+def fold_subsets(params, folds: pd.DataFrame) -> list[tuple[str, pd.DataFrame, str, str]]:
+    """(legend label, rows, colour, dash) of each kind of fold row: the paper's two families,
+    or a framework's folds that change the stable count, those that do not, cable switches."""
+    if isinstance(params, Params):
+        families = (("relaxed", "#d95f02"), ("tensioned", "#e7298a"))
+        return [(f"fold ({family} equilibria)",
+                 folds[(folds.family == family) & (folds.kind == "fold")], colour, "solid")
+                for family, colour in families]  # fmt: skip
+    switch = (folds.kind == "cable_switch").to_numpy()
+    changes = folds.changes_stable_count.to_numpy(bool) & ~switch
+    subsets = {"changes": changes, "no_change": ~changes & ~switch, "switch": switch}
+    return [(label, folds[subsets[which]], style["color"], _DASH[style["ls"]])
+            for which, _, style, label in _STYLES]  # fmt: skip
+
+
+_DASH = {"-": "solid", "--": "dash", "-.": "dashdot"}
+
+
 def _paper_folds(ax: Axes, folds: pd.DataFrame) -> list:
     """The paper's fold points, one colour per family (sampled along the parallel curve)."""
     handles = []
-    for family, colour in (("relaxed", "#d95f02"), ("tensioned", "#e7298a")):
-        f = folds[(folds.family == family) & (folds.kind == "fold")]
+    for label, f, colour, _ in fold_subsets(Params(), folds):
+        family = label.split("(")[1].split()[0]
         ax.plot(f.L01, f.L02, ".", ms=1.2, color=colour, gid=f"fold-{family}")
-        handles.append(Line2D([], [], marker="o", ls="", ms=5, color=colour,
-                              label=f"fold ({family} equilibria)"))  # fmt: skip
+        handles.append(Line2D([], [], marker="o", ls="", ms=5, color=colour, label=label))
     return handles
 
 
@@ -97,12 +114,9 @@ def _curves(ax: Axes, folds: pd.DataFrame, axes: tuple[str, str], grid: tuple) -
     from ..catastrophe.regions import polylines
 
     window = tuple((g.min(), g.max()) for g in grid)
-    switch = (folds.kind == "cable_switch").to_numpy()
-    changes = folds.changes_stable_count.to_numpy(bool) & ~switch
-    subsets = {"changes": changes, "no_change": ~changes & ~switch, "switch": switch}
     handles = []
-    for which, gid, style, label in _STYLES:
-        part = folds[subsets[which]]
+    for (_, gid, style, label), (_, part, _, _) in zip(_STYLES, fold_subsets(None, folds),
+                                                       strict=True):  # fmt: skip
         for line in polylines(part, *axes, window):
             rows = part.iloc[line]
             marker = "." if len(rows) == 1 else None

@@ -1,0 +1,133 @@
+"""The explorer's three pages (plot/explore.py draws their data): a map (click a grid point), a
+sweep (a slider along the swept parameter) and a move (a slider along the path)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..params import Params
+from .explore import axis_title, page_data, write_page
+
+BLUES = ["#eef4fb", "#c6dbef", "#6baed6", "#2171b5", "#08306b", "#041d42"]
+
+
+def map_page(dm, path: str | Path, overlay: pd.DataFrame | None = None) -> Path:
+    """A map's page: stable counts (hover: both counts), fold curves, cusps and cable switches;
+    a click draws the equilibria of the 2-D sweep at that grid point. `overlay`: a path (a
+    plan's) drawn over it."""
+    import plotly.graph_objects as go
+
+    from ..analysis.classify import read_table
+
+    model, (x, y) = dm.params, dm.axes
+    xs, ys = np.unique(dm.regions[x].to_numpy(float)), np.unique(dm.regions[y].to_numpy(float))
+    grid = {c: dm.regions.pivot(index=y, columns=x, values=c).loc[ys, xs].to_numpy(int)
+            for c in ("stable", "physical")}  # fmt: skip
+    table = read_table(Path(dm.record["sweep_folder"]) / "sweep.csv")
+    phys = table[table.physical.astype(bool)]
+    data = page_data(model, phys, phys.point.to_numpy(int), len(xs) * len(ys))
+    top = max(int(grid["stable"].max()), 1)
+    scale = [[k / top, BLUES[min(k, len(BLUES) - 1)]] for k in range(top + 1)]
+    fig = go.Figure(go.Heatmap(
+        x=xs, y=ys, z=grid["stable"], customdata=grid["physical"], colorscale=scale, zmin=0,
+        zmax=top, colorbar={"title": {"text": "stable"}, "dtick": 1}, name="stable count",
+        hovertemplate=f"{x} = %{{x}}<br>{y} = %{{y}}<br>stable: %{{z}}<br>"
+        "physical: %{customdata}<extra></extra>"))  # fmt: skip
+    for trace in _fold_traces(dm, x, y, xs, ys):
+        fig.add_trace(trace)
+    if overlay is not None and len(overlay):
+        fig.add_trace(go.Scatter(x=overlay[x], y=overlay[y], mode="lines+markers", name="plan",
+                                 line={"color": "black", "width": 3}))  # fmt: skip
+    fig.update_layout(xaxis_title=axis_title(x), yaxis_title=axis_title(y),
+                      legend={"orientation": "h", "y": -0.15}, margin={"t": 30})  # fmt: skip
+    values = model.as_dict()
+    start = [min(max(values[n], g.min()), g.max()) for n, g in ((x, xs), (y, ys))]
+    data.update(page="map", axes=[x, y], xs=xs.tolist(), ys=ys.tolist(), start_at=start)
+    name = getattr(model, "name", "the paper's mechanism")
+    note = (f"{name}: click a grid point to draw its physical equilibria (from the map's own "
+            f"2-D sweep, {len(xs)} x {len(ys)} points); hover for the counts.")  # fmt: skip
+    return write_page(path, f"{name}: map over ({x}, {y})", note, fig, data)
+
+
+def _fold_traces(dm, x: str, y: str, xs: np.ndarray, ys: np.ndarray) -> list:
+    """The fold curves (the paper's: points by family; a framework's: polylines of the folds
+    that change the stable count, those that do not, and cable switches), and the cusps."""
+    import plotly.graph_objects as go
+
+    from ..catastrophe.regions import polylines
+    from .design_map import fold_subsets
+
+    folds, out = dm.folds, []
+    for label, rows, colour, dash in fold_subsets(dm.params, folds):
+        if isinstance(dm.params, Params):
+            dots = {"size": 2, "color": colour}
+            out.append(go.Scatter(x=rows[x], y=rows[y], mode="markers", name=label,
+                                  marker=dots, hoverinfo="skip"))  # fmt: skip
+            continue
+        px, py = [], []
+        for line in polylines(rows, x, y, ((xs.min(), xs.max()), (ys.min(), ys.max()))):
+            px += [*rows[x].iloc[line], None]
+            py += [*rows[y].iloc[line], None]
+        out.append(go.Scatter(x=px, y=py, mode="lines", name=label, hoverinfo="skip",
+                              line={"color": colour, "dash": dash, "width": 2}))  # fmt: skip
+    cusps = folds[folds.kind == "cusp"]
+    out.append(go.Scatter(x=cusps[x], y=cusps[y], mode="markers", name="cusp",
+                          marker={"symbol": "triangle-down", "size": 9, "color": "white",
+                                  "line": {"color": "black", "width": 1}}))  # fmt: skip
+    return out
+
+
+def _coordinate(model) -> str:
+    """The column a diagram draws: gamma1, or the framework's first pose column."""
+    if isinstance(model, Params):
+        return "gamma1_deg"
+    from ..continuation.framework import pose_names
+
+    return pose_names(model)[0]
+
+
+def sweep_page(model, table: pd.DataFrame, param: str, values, path: str | Path) -> Path:
+    """A one-parameter sweep's page: the bifurcation diagram (stable filled, the rest open) and
+    a slider along the swept parameter that draws every physical equilibrium there."""
+    import plotly.graph_objects as go
+
+    phys = table[table.physical.astype(bool)]
+    data = page_data(model, phys, phys.point.to_numpy(int), len(values))
+    ycol = _coordinate(model)
+    fig = go.Figure()
+    for stable, label in ((True, "stable"), (False, "unstable")):
+        part = phys[phys.stable.astype(bool) == stable]
+        fig.add_trace(go.Scatter(x=part[param], y=part[ycol], mode="markers", name=label,
+                                 marker={"size": 4, "symbol": "circle" if stable else
+                                         "circle-open"}))  # fmt: skip
+    fig.update_layout(xaxis_title=axis_title(param), yaxis_title=ycol, margin={"t": 30})
+    labels = [f"{param} = {v:.6g}" for v in values]
+    data.update(page="sweep", labels=labels, at=[float(v) for v in values])
+    name = getattr(model, "name", "the paper's mechanism")
+    note = f"{name}: move the slider to draw the physical equilibria at each sweep point."
+    return write_page(path, f"{name}: sweep over {param}", note, fig, data, slider=param)
+
+
+def move_page(mv, path: str | Path) -> Path:
+    """A move's page: the followed state against the path (snaps marked) and a slider along
+    the steps that draws the mechanism."""
+    import plotly.graph_objects as go
+
+    table, names = mv.table, list(mv.path.names)
+    along = names[0] if len(names) == 1 else "s"
+    ycol = _coordinate(mv.params)
+    data = page_data(mv.params, table.assign(kind="min", stable=True), np.arange(len(table)),
+                     len(table))  # fmt: skip
+    fig = go.Figure(go.Scatter(x=table[along], y=table[ycol], mode="lines", name="state"))
+    snaps = table[table.event == "snap_to"]
+    fig.add_trace(go.Scatter(x=snaps[along], y=snaps[ycol], mode="markers", name="after a snap",
+                             marker={"color": "red", "size": 9}))  # fmt: skip
+    fig.update_layout(xaxis_title=axis_title(along), yaxis_title=ycol, margin={"t": 30})
+    labels = [", ".join(f"{n} = {row[n]:.6g}" for n in names) + f" ({row.event})"
+              for _, row in table.iterrows()]  # fmt: skip
+    data.update(page="move", labels=labels, at=table[along].astype(float).tolist())
+    note = f"state #{mv.state} moved along {mv.path.as_dict()}: {len(mv.snaps)} snaps."
+    return write_page(path, f"move of state #{mv.state}", note, fig, data, slider="step")

@@ -55,7 +55,12 @@ def test_the_map_page_is_one_offline_file_of_the_maps_own_equilibria(paper_map):
     text = page.read_text()
     assert not re.search(r"<(script|link|img|iframe)[^>]*\s(src|href)\s*=", text)
     data = page_data(page)
-    coords = floats(data["coords"]).reshape(-1, 6, 2)
+    moving = data["moving"]
+    assert sorted(moving) == [3, 4, 5] and set(data["fixed"]) == {"0", "1", "2"}  # P1-P3 still
+    coords = np.zeros((len(data["sid"]), 6, 2))
+    coords[:, moving] = floats(data["coords"]).reshape(-1, len(moving), 2)
+    for p, xy in data["fixed"].items():
+        coords[:, int(p)] = xy
     assert len(data["xs"]) == len(data["ys"]) == 9
     for k in range(81):
         rows = _rows_at(table, k)

@@ -126,9 +126,19 @@ def page_data(model, rows: pd.DataFrame, point: np.ndarray, points: int) -> dict
         "sid": rows["solution_id"].astype(int).tolist() if "solution_id" in rows else
         list(range(1, len(rows) + 1)),
         "kind": kind, "stable": stable.astype(int).tolist(),
-        "coords": _floats(coordinates(model, rows)),
+        **_split_fixed(coordinates(model, rows)),
         "columns": {n: _floats(v) for n, v in table_columns(model, rows).items()},
     }  # fmt: skip
+
+
+def _split_fixed(xyz: np.ndarray) -> dict:
+    """The points that sit still in every row (a ground point, the paper's bottom body) sent
+    once (`fixed`: {index: coordinates}); the others as float32 (`coords`: rows x moving
+    points x dim, in the order of `moving`)."""
+    still = [bool(len(xyz)) and bool((xyz[:, p] == xyz[0, p]).all()) for p in range(xyz.shape[1])]
+    moving = [p for p, s in enumerate(still) if not s]
+    return {"fixed": {str(p): xyz[0, p].tolist() for p, s in enumerate(still) if s},
+            "moving": moving, "coords": _floats(xyz[:, moving])}  # fmt: skip
 
 
 def write_page(path: str | Path, title: str, note: str, figure, data: dict,

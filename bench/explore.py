@@ -3,7 +3,8 @@
 
 Usage: .venv/bin/python bench/explore.py [--points N] [--map FOLDER]
   --map FOLDER: a saved map (runs/map/latest) instead of making one (the 101 x 101 map takes
-  minutes; `make explore` writes one with its page).
+  minutes; `make explore` writes one with its page). Without it the map is made in an empty
+  cache, end to end (fold curves, their generic sets and the 2-D sweep).
 Benchmarks, not tests: nothing is asserted; targets are printed beside the measurements.
 """
 
@@ -21,6 +22,10 @@ SIZE_TARGET_MB, OPEN_TARGET_S = 15.0, 3.0
 
 
 def _map(points: int, folder: str | None):
+    if folder is None:  # an empty cache: a cached 2-D sweep would be resumed, not solved
+        import os
+
+        os.environ["COTM_CACHE"] = tempfile.mkdtemp(prefix="explore-bench-cache-")
     import cotm_bertini as cb
     from cotm_bertini.api.maps import DesignMap
     from cotm_bertini.params import Params

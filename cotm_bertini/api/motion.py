@@ -78,19 +78,26 @@ class Move:
     def save(self, folder: str | Path, plots: bool = True, html: bool = False) -> Path:
         """trajectory.csv, snaps.csv, columns.md, run.json [, move.png/svg, move.gif]
         [, explore.html] in a new folder, built under a hidden name and renamed when complete."""
-        tables = ("move", "snaps") if isinstance(self.params, Params) else (
-            "framework_move", "snaps")  # fmt: skip
         with new_folder(folder) as work:
-            write_csv(work / "trajectory.csv", self.table)
-            write_csv(work / "snaps.csv", self.snaps)
-            atomic_write_text(work / "columns.md", reference(*tables))
+            atomic_write_text(work / "columns.md", reference(_move_table(self.params), "snaps"))
             write_json(work / "run.json", self.record)
-            if plots:
-                self.plot(work / "move")
-                self.animate(work / "move.gif")
+            self.write_into(work, plots)
             if html:
                 self.explore(work / "explore.html")
         return Path(folder)
+
+    def write_into(self, work: Path, plots: bool) -> None:
+        """trajectory.csv, snaps.csv [, move.png/svg, move.gif] into a folder being built."""
+        write_csv(work / "trajectory.csv", self.table)
+        write_csv(work / "snaps.csv", self.snaps)
+        if plots:
+            self.plot(work / "move")
+            self.animate(work / "move.gif")
+
+
+def _move_table(model) -> str:
+    """The columns.md table of a trajectory: the paper's or a framework's."""
+    return "move" if isinstance(model, Params) else "framework_move"
 
 
 def move(
@@ -238,17 +245,13 @@ class Plan:
         in a new folder."""
         with new_folder(folder) as work:
             write_csv(work / "plan.csv", self.path)
-            if self.move is not None:
-                write_csv(work / "trajectory.csv", self.move.table)
-                write_csv(work / "snaps.csv", self.move.snaps)
-            move_table = "move" if isinstance(self.params, Params) else "framework_move"
-            atomic_write_text(work / "columns.md", reference("plan", move_table, "snaps"))
+            tables = ("plan", _move_table(self.params), "snaps")
+            atomic_write_text(work / "columns.md", reference(*tables))
             write_json(work / "run.json", self.record)
+            if self.move is not None:
+                self.move.write_into(work, plots)
             if plots:
                 self.plot(work / "plan")
-                if self.move is not None:
-                    self.move.plot(work / "move")
-                    self.move.animate(work / "move.gif")
             if html:
                 self.explore(work / "explore.html")
         return Path(folder)

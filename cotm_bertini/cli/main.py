@@ -166,18 +166,28 @@ def _move_parser(sub) -> None:
         "along the path, piecewise linear; at a fold or a cable switch it snaps to the minimum "
         "it falls into. Writes trajectory.csv, snaps.csv, run.json, move.png and move.gif.",
     )
-    add_case(m)
-    add_params(m)
-    add_settings(m)
-    m.add_argument("--state", type=int, required=True, metavar="ID", help="a stable solution_id")
+    _state_options(m)
     m.add_argument("--path", action="append", required=True, metavar="NAME=V0,V1,...",
                    help="waypoints of one parameter (repeatable; as many for each)")  # fmt: skip
     m.add_argument("--steps", type=int, default=100, help="recorded steps a segment (default 100)")
-    m.add_argument("--out", metavar="DIR", help="default runs/move-<label>")
-    m.add_argument("--no-plots", action="store_true", help="skip move.png/svg and move.gif")
-    m.add_argument("--html", action="store_true", help=HTML_HELP)
-    m.add_argument("--quiet", action="store_true", help="no progress report")
+    _run_options(m, "move", "move.png/svg and move.gif")
     m.set_defaults(run=commands.move)
+
+
+def _state_options(p) -> None:
+    """The mechanism, its solver settings and the stable state a move or plan starts from."""
+    add_case(p)
+    add_params(p)
+    add_settings(p)
+    p.add_argument("--state", type=int, required=True, metavar="ID", help="a stable solution_id")
+
+
+def _run_options(p, name: str, plots: str) -> None:
+    """Where a move's or plan's run folder goes and what it holds."""
+    p.add_argument("--out", metavar="DIR", help=f"default runs/{name}-<label>")
+    p.add_argument("--no-plots", action="store_true", help=f"skip {plots}")
+    p.add_argument("--html", action="store_true", help=HTML_HELP)
+    p.add_argument("--quiet", action="store_true", help="no progress report")
 
 
 def _plan_parser(sub) -> None:
@@ -190,16 +200,10 @@ def _plan_parser(sub) -> None:
         "move along it. Writes plan.csv, the move's trajectory.csv and snaps.csv, run.json, "
         "plan.png, move.png, move.gif. 'unreachable' (exit 0) is an answer.",
     )
-    add_case(p)
-    add_params(p)
-    add_settings(p)
-    p.add_argument("--state", type=int, required=True, metavar="ID", help="a stable solution_id")
+    _state_options(p)
     p.add_argument("--goal", type=int, required=True, metavar="ID", help="another stable one")
     _window_options(p, points=41)
-    p.add_argument("--out", metavar="DIR", help="default runs/plan-<label>")
-    p.add_argument("--no-plots", action="store_true", help="skip plan.png, move.png, move.gif")
-    p.add_argument("--html", action="store_true", help=HTML_HELP)
-    p.add_argument("--quiet", action="store_true", help="no progress report")
+    _run_options(p, "plan", "plan.png, move.png, move.gif")
     p.set_defaults(run=commands.plan)
 
 

@@ -191,3 +191,32 @@ def test_a_two_parameter_sweep_page_is_refused_before_any_work(tmp_path):
                    "--out", str(tmp_path / "w"))  # fmt: skip
     assert done.returncode == 2 and done.stderr.count("\n") == 1 and "--html" in done.stderr
     assert not (tmp_path / "w").exists()
+
+
+def test_a_plans_page_walks_its_move_over_the_map(browser, tmp_path):
+    """A plan between Zeeman's states: its path on the map, and the slider walks the move that
+    checks it: each step's drawn rim is the trajectory's, the map's marker at its (x, y)."""
+    from selenium.webdriver.common.keys import Keys
+
+    fw = cb.Framework.from_toml(ROOT / "examples" / "zeeman.toml").replace(x=0.1, y=-0.25)
+    res = cb.solve(fw)
+    a, b = res.stable.solution_id.tolist()
+    pl = cb.plan(res, a, b, ("x", (-0.6, 0.8), "y", (-0.8, 0.2)), points=15)
+    assert pl.status == "ok"
+    page = pl.explore(tmp_path / "explore.html")
+    _open(browser, page, "plan.png")
+    names = browser.execute_script("return document.getElementById('main').data.map(t => t.name)")
+    assert "plan" in names
+    slider = browser.find_element("id", "slider")
+    rim = page_data(page)["skeleton"]["points"].index("wheel.rim")
+    for k in range(1, len(pl.move.table), 7):  # the first key press starts the walk
+        while int(slider.get_attribute("value")) < k:
+            slider.send_keys(Keys.ARROW_RIGHT)
+        (drawn,) = browser.execute_script("return window.explorer.drawn()")
+        row = pl.move.table.iloc[k]
+        assert np.abs(np.array(drawn["points"][rim]) - [row["wheel.rim.x"], row["wheel.rim.y"]]
+                      ).max() < 1e-5  # fmt: skip
+        shape = browser.execute_script("return document.getElementById('main').layout.shapes[0]")
+        centre = [(shape["x0"] + shape["x1"]) / 2, (shape["y0"] + shape["y1"]) / 2]
+        assert np.abs(np.array(centre) - [row.x, row.y]).max() < 1e-9
+    browser.save_screenshot(str(ARTEFACTS / "plan-walked.png"))

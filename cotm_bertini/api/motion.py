@@ -234,10 +234,11 @@ class Plan:
         return plot_plan(self, path)
 
     def explore(self, path: str | Path) -> Path:
-        """explore.html: the plan's map in a browser, offline, with the path drawn on it."""
+        """explore.html: the plan's map in a browser, offline, with the path drawn on it and a
+        slider that walks the move along it."""
         from ..plot.explore_pages import map_page
 
-        return map_page(self.map, path, overlay=self.path)
+        return map_page(self.map, path, route=self.path, move=self.move)
 
     def save(self, folder: str | Path, plots: bool = True, html: bool = False) -> Path:
         """plan.csv, run.json, columns.md [, plan.png/svg] [, explore.html: the map with the

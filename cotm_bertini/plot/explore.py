@@ -123,8 +123,8 @@ def page_data(model, rows: pd.DataFrame, point: np.ndarray, points: int) -> dict
         "skeleton": {"points": sk.points, "elements": sk.elements}, "dim": sk.dim,
         "start": np.searchsorted(point, np.arange(points)).tolist(),
         "count": np.bincount(point, minlength=points).tolist(),
-        "sid": rows["solution_id"].astype(int).tolist() if "solution_id" in rows else
-        list(range(1, len(rows) + 1)),
+        "id_name": "solution_id" if "solution_id" in rows else "step",
+        "sid": rows["solution_id" if "solution_id" in rows else "step"].astype(int).tolist(),
         "kind": kind, "stable": stable.astype(int).tolist(),
         **_split_fixed(coordinates(model, rows)),
         "columns": {n: _floats(v) for n, v in table_columns(model, rows).items()},
@@ -151,7 +151,7 @@ def write_page(path: str | Path, title: str, note: str, figure, data: dict,
     data = {**data, "figure": json.loads(figure.to_json())}
     text = jinja2.Template(page_template("explore.html.j2")).render(
         title=title, note=note, plotly_js=get_plotlyjs(), slider=slider,
-        slider_max=len(data.get("labels", [0])) - 1,
+        slider_max=len((data.get("track") or data).get("labels", [0])) - 1,
         data=json.dumps(data, separators=(",", ":")).replace("</", "<\\/"),
     )  # fmt: skip
     out = Path(path)

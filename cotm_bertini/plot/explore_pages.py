@@ -14,10 +14,10 @@ from .explore import axis_title, page_data, write_page
 BLUES = ["#eef4fb", "#c6dbef", "#6baed6", "#2171b5", "#08306b", "#041d42"]
 
 
-def map_page(dm, path: str | Path, overlay: pd.DataFrame | None = None) -> Path:
+def map_page(dm, path: str | Path, route: pd.DataFrame | None = None, move=None) -> Path:
     """A map's page: stable counts (hover: both counts), fold curves, cusps and cable switches;
-    a click draws the equilibria of the 2-D sweep at that grid point. `overlay`: a path (a
-    plan's) drawn over it."""
+    a click draws the equilibria of the 2-D sweep at that grid point. `route` (a plan's
+    waypoints) is drawn over it, and `move` (the move along it) walked by a slider."""
     import plotly.graph_objects as go
 
     from ..analysis.classify import read_table
@@ -38,18 +38,39 @@ def map_page(dm, path: str | Path, overlay: pd.DataFrame | None = None) -> Path:
         "physical: %{customdata}<extra></extra>"))  # fmt: skip
     for trace in _fold_traces(dm, x, y, xs, ys):
         fig.add_trace(trace)
-    if overlay is not None and len(overlay):
-        fig.add_trace(go.Scatter(x=overlay[x], y=overlay[y], mode="lines+markers", name="plan",
+    if route is not None and len(route):
+        fig.add_trace(go.Scatter(x=route[x], y=route[y], mode="lines+markers", name="plan",
                                  line={"color": "black", "width": 3}))  # fmt: skip
     fig.update_layout(xaxis_title=axis_title(x), yaxis_title=axis_title(y),
                       legend={"orientation": "h", "y": -0.15}, margin={"t": 30})  # fmt: skip
     values = model.as_dict()
     start = [min(max(values[n], g.min()), g.max()) for n, g in ((x, xs), (y, ys))]
-    data.update(page="map", axes=[x, y], xs=xs.tolist(), ys=ys.tolist(), start_at=start)
+    data.update(page="map", axes=[x, y], xs=xs.tolist(), ys=ys.tolist(), start_at=start,
+                dot=[0.01 * np.ptp(xs), 0.01 * np.ptp(ys)])  # fmt: skip
     name = getattr(model, "name", "the paper's mechanism")
     note = (f"{name}: click a grid point to draw its physical equilibria (from the map's own "
             f"2-D sweep, {len(xs)} x {len(ys)} points); hover for the counts.")  # fmt: skip
-    return write_page(path, f"{name}: map over ({x}, {y})", note, fig, data)
+    slider = ""
+    if move is not None:
+        data["track"] = _track(move, (x, y))
+        slider, note = "the plan's move", note + " The slider walks the plan's move."
+    return write_page(path, f"{name}: map over ({x}, {y})", note, fig, data, slider=slider)
+
+
+def _track(mv, axes: tuple[str, str]) -> dict:
+    """A move's steps as drawable rows, one a step, with their labels and places on the map."""
+    table = mv.table
+    track = page_data(mv.params, table.assign(kind="min", stable=True), np.arange(len(table)),
+                      len(table))  # fmt: skip
+    track["labels"] = _step_labels(table, list(mv.path.names))
+    track["at"] = table[list(axes)].to_numpy(float).tolist()
+    return track
+
+
+def _step_labels(table: pd.DataFrame, names: list[str]) -> list[str]:
+    """Each step of a trajectory: its parameter values and event."""
+    return [", ".join(f"{n} = {row[n]:.6g}" for n in names) + f" ({row.event})"
+            for _, row in table.iterrows()]  # fmt: skip
 
 
 def _fold_traces(dm, x: str, y: str, xs: np.ndarray, ys: np.ndarray) -> list:
@@ -126,8 +147,7 @@ def move_page(mv, path: str | Path) -> Path:
     fig.add_trace(go.Scatter(x=snaps[along], y=snaps[ycol], mode="markers", name="after a snap",
                              marker={"color": "red", "size": 9}))  # fmt: skip
     fig.update_layout(xaxis_title=axis_title(along), yaxis_title=ycol, margin={"t": 30})
-    labels = [", ".join(f"{n} = {row[n]:.6g}" for n in names) + f" ({row.event})"
-              for _, row in table.iterrows()]  # fmt: skip
-    data.update(page="move", labels=labels, at=table[along].astype(float).tolist())
+    data.update(page="move", labels=_step_labels(table, names),
+                at=table[along].astype(float).tolist())  # fmt: skip
     note = f"state #{mv.state} moved along {mv.path.as_dict()}: {len(mv.snaps)} snaps."
     return write_page(path, f"move of state #{mv.state}", note, fig, data, slider="step")

@@ -244,6 +244,7 @@ def _deg_gap_col(a, b) -> np.ndarray:
         ({"path": {"y": [-0.8, float("nan")]}}, "not a finite number"),
         ({"path": {"y": [-0.8, 0.2]}, "state": 2}, "not a stable solution_id"),
         ({"path": {"y": [-0.8, 0.2]}, "steps": 0}, "steps = 0"),
+        ({"path": {"y": [-0.8, 1e15]}}, "y = 1e"),  # a waypoint the framework refuses
     ],
 )
 def test_bad_input_is_refused_in_one_line(zeeman_move, kwargs, message):

@@ -115,6 +115,8 @@ def move(
         raise ParameterError(f"steps = {steps!r}: expected a whole number >= 1")
     model = res.params
     ap = actuator_path(path, model.as_dict())
+    for k in range(len(ap.waypoints)):  # each waypoint's values valid, before any work
+        model.replace(**ap.at(k))
     row = _stable_row(res, state)
     t0 = time.perf_counter()
     flow = flow_of(model, res.table)

@@ -53,7 +53,7 @@ class Snap:
 
     s: float
     s_after: float
-    kind: str  # fold, cable_switch or unexplained
+    kind: str  # fold, cable_switch, unexplained or degenerate
     before: np.ndarray
     after: np.ndarray | None
     released: float  # J: V(before) - V(after), both at s_after

@@ -15,8 +15,7 @@ def newton_refine(system: PolySystem, x: np.ndarray, steps: int) -> tuple[np.nda
     scale = system.scale()
     res = np.abs(system.evaluate(x) / scale).max(axis=1)
     for _ in range(steps):
-        f = system.evaluate(x)
-        jac = system.jacobian(x)
+        f, jac = system.value_and_jacobian(x)
         step = np.zeros_like(x)
         ok = np.isfinite(jac).all(axis=(1, 2))
         try:

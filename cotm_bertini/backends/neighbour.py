@@ -268,7 +268,8 @@ def _newton(system, x: np.ndarray) -> tuple[np.ndarray | None, np.ndarray]:
         for _ in range(NEWTON_ITERATIONS):
             xa = x[active]
             try:
-                step = np.linalg.solve(system.jacobian(xa), system.evaluate(xa)[..., None])
+                f, jac = system.value_and_jacobian(xa)
+                step = np.linalg.solve(jac, f[..., None])
             except np.linalg.LinAlgError:
                 return None, size
             xa = xa - step[..., 0]

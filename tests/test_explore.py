@@ -22,7 +22,7 @@ from cotm_bertini.analysis.classify import read_table
 
 ROOT = Path(__file__).resolve().parent.parent
 ARTEFACTS = Path(os.environ.get("COTM_TEST_ARTEFACTS", ROOT / "runs" / "test-artefacts"))
-pytestmark = pytest.mark.xdist_group("explore")
+pytestmark = pytest.mark.xdist_group("zeeman-map")  # as tests/test_motion.py: one cache
 
 
 def page_data(path: Path) -> dict:

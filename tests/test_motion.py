@@ -19,6 +19,9 @@ from cotm_bertini.api.motion import move
 ROOT = Path(__file__).resolve().parent.parent
 SLACK = ROOT / "tests" / "fixtures" / "zeeman_slack.toml"
 PAPER_FOLD_L01 = 11.0128  # case 2's fold on L01 (the paper, Fig. 5)
+# One xdist worker for the moves and the explorer: both map Zeeman's machine over one window, and
+# a worker's cache then solves its fold curves and 2-D sweep once.
+pytestmark = pytest.mark.xdist_group("zeeman-map")
 
 
 # --- an independent quasi-static simulation in one angle ----------------------------------------
@@ -277,15 +280,16 @@ def test_the_command_line_writes_the_run(tmp_path):
 # --- plans -------------------------------------------------------------------------------------
 
 WINDOW = ("x", (-0.6, 0.8), "y", (-0.8, 0.2))
+ZEEMAN_POINTS = 15  # tests/test_explore.py maps the same window alike: its sweep is then cached
 
 
 @pytest.fixture(scope="module")
 def zeeman_bistable():
-    """Zeeman's machine inside its bistable region, and a 21 x 21 map around it."""
+    """Zeeman's machine inside its bistable region, and a 15 x 15 map around it."""
     fw = cb.Framework.from_toml(ROOT / "examples" / "zeeman.toml").replace(x=0.1, y=-0.25)
     res = cb.solve(fw)
     assert len(res.stable) == 2
-    return res, cb.design_map(fw, *WINDOW, points=21)
+    return res, cb.design_map(fw, *WINDOW, points=ZEEMAN_POINTS)
 
 
 def _simulate_waypoints(path, theta: float) -> tuple[float, int]:

@@ -220,3 +220,33 @@ def test_a_plans_page_walks_its_move_over_the_map(browser, tmp_path):
         centre = [(shape["x0"] + shape["x1"]) / 2, (shape["y0"] + shape["y1"]) / 2]
         assert np.abs(np.array(centre) - [row.x, row.y]).max() < 1e-9
     browser.save_screenshot(str(ARTEFACTS / "plan-walked.png"))
+
+
+def test_a_path_drawn_on_the_map_gives_the_command_that_moves_along_it(paper_map, browser):
+    """Drawing: three clicks add three waypoints (grid points), a dashed path appears, and the
+    page writes the `move` command for it, with the stable ids at its start."""
+    from selenium.webdriver.common.action_chains import ActionChains
+
+    dm, page, table = paper_map
+    _open(browser, page, "map-draw.png")
+    browser.find_element("id", "draw").click()
+    main = browser.find_element("id", "main")
+    picks = [(2, 2), (6, 2), (6, 5)]
+    for i, j in picks:
+        px, py = browser.execute_script(f"return window.explorer.pixel({i}, {j})")
+        ActionChains(browser).move_to_element_with_offset(
+            main, int(px - main.size["width"] / 2), int(py - main.size["height"] / 2)
+        ).click().perform()
+    xs, ys = page_data(page)["xs"], page_data(page)["ys"]
+    assert browser.execute_script("return window.explorer.drawing()") == [
+        [xs[i], ys[j]] for i, j in picks
+    ]
+    names = browser.execute_script("return document.getElementById('main').data.map(t => t.name)")
+    assert names.count("drawn path") == 1  # one trace, redrawn at each click
+    command = browser.find_element("id", "command").text
+    l01 = ",".join(f"{xs[i]:g}" for i, _ in picks)
+    assert command.startswith("cotm-bertini move --set L01=") and f"--path L01={l01}" in command
+    rows = _rows_at(table, picks[0][0] * 9 + picks[0][1])
+    stable = ", ".join(str(s) for s in rows.solution_id[rows.stable.astype(bool)])
+    assert f"({stable})" in command
+    browser.save_screenshot(str(ARTEFACTS / "map-drawn.png"))

@@ -142,7 +142,7 @@ def _split_fixed(xyz: np.ndarray) -> dict:
 
 
 def write_page(path: str | Path, title: str, note: str, figure, data: dict,
-               slider: str = "") -> Path:  # fmt: skip
+               slider: str = "", draw: bool = False) -> Path:  # fmt: skip
     """explore.html: the template filled with the figure, the data and plotly.js, written
     atomically."""
     import jinja2
@@ -150,7 +150,7 @@ def write_page(path: str | Path, title: str, note: str, figure, data: dict,
 
     data = {**data, "figure": json.loads(figure.to_json())}
     text = jinja2.Template(page_template("explore.html.j2")).render(
-        title=title, note=note, plotly_js=get_plotlyjs(), slider=slider,
+        title=title, note=note, plotly_js=get_plotlyjs(), slider=slider, draw=draw,
         slider_max=len((data.get("track") or data).get("labels", [0])) - 1,
         data=json.dumps(data, separators=(",", ":")).replace("</", "<\\/"),
     )  # fmt: skip

@@ -46,7 +46,8 @@ def map_page(dm, path: str | Path, route: pd.DataFrame | None = None, move=None)
     values = model.as_dict()
     start = [min(max(values[n], g.min()), g.max()) for n, g in ((x, xs), (y, ys))]
     data.update(page="map", axes=[x, y], xs=xs.tolist(), ys=ys.tolist(), start_at=start,
-                dot=[0.01 * np.ptp(xs), 0.01 * np.ptp(ys)])  # fmt: skip
+                dot=[0.01 * np.ptp(xs), 0.01 * np.ptp(ys)],
+                command=_move_command(model, (x, y)))  # fmt: skip
     name = getattr(model, "name", "the paper's mechanism")
     note = (f"{name}: click a grid point to draw its physical equilibria (from the map's own "
             f"2-D sweep, {len(xs)} x {len(ys)} points); hover for the counts.")  # fmt: skip
@@ -54,7 +55,21 @@ def map_page(dm, path: str | Path, route: pd.DataFrame | None = None, move=None)
     if move is not None:
         data["track"] = _track(move, (x, y))
         slider, note = "the plan's move", note + " The slider walks the plan's move."
-    return write_page(path, f"{name}: map over ({x}, {y})", note, fig, data, slider=slider)
+    return write_page(path, f"{name}: map over ({x}, {y})", note, fig, data, slider=slider,
+                      draw=True)  # fmt: skip
+
+
+def _move_command(model, axes: tuple[str, str]) -> str:
+    """The start of the command line that moves a state of this model: its values other than
+    the map's axes (the paper's: those that are not Table 1's)."""
+    values = {n: v for n, v in model.as_dict().items() if n not in axes}
+    if isinstance(model, Params):
+        table1 = Params().as_dict()
+        head = ["cotm-bertini move"]
+        values = {n: v for n, v in values.items() if v != table1[n]}
+    else:
+        head = ["cotm-bertini move --framework", model.source or f"{model.name}.toml"]
+    return " ".join([*head, *(f"--set {n}={v:.12g}" for n, v in values.items())])
 
 
 def _track(mv, axes: tuple[str, str]) -> dict:

@@ -336,8 +336,15 @@ def move(args: argparse.Namespace) -> int:
     if len(found.snaps):
         cols = ["snap", *path, "kind", "released"]
         print(found.snaps[cols].to_string(index=False))
-    ends = found.ends_in
-    print(f"ends in state {ends}" if ends is not None else "ends at the path's last waypoint")
+    ends, wp, last = found.ends_in, found.path.waypoints, float(found.table.s.iloc[-1])
+    if last < found.path.segments:
+        print(f"stops at path position {last:.10g} of {found.path.segments} (see the warning)")
+    elif ends is not None:
+        print(f"ends in state {ends}")
+    elif (wp[-1] == wp[0]).all():
+        print("ends back at the solve's values in none of its stable states")
+    else:
+        print("ends at the path's last waypoint (its state: the last row of trajectory.csv)")
     print(_files_line(folder))
     return EXIT_INCOMPLETE if found.warnings else EXIT_OK
 

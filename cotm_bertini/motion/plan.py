@@ -110,7 +110,7 @@ def plan_path(
                 if cost < best.get(nkey, (np.inf, np.inf)):
                     best[nkey], came[nkey], states[nkey] = cost, key, y
                     heapq.heappush(heap, (*cost, next(counter), nkey, y))
-    return Planned([], 0, 0.0, len(best), search.simulated, search.unlisted)
+    return Planned([], 0, 0.0, report.done, search.simulated, search.unlisted)
 
 
 class _Search:
@@ -123,7 +123,8 @@ class _Search:
 
     def step(self, a: dict, b: dict, x: np.ndarray) -> tuple[np.ndarray, int] | None:
         """The state after moving the parameters from a to b, and the snaps on the way (None:
-        a snap fell nowhere, or the step is no move at all)."""
+        x is no minimum at a, or the follower warned: a snap fell nowhere, or an end it could
+        not name or a degenerate one, which a plan does not pass)."""
         if a == b:
             return x, 0
         names = tuple(a)

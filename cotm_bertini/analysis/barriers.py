@@ -36,6 +36,7 @@ MAX_STEPS = 20000
 ZERO_LENGTH = 1e-3  # relative to L3 (a framework: its length unit)
 MATCH_DEG = 1e-5  # a descent end within this (deg, on the torus) of a minimum is that minimum
 NEWTON_RANGE = 0.1  # Newton's step is taken once it is shorter than this
+STALLED = 1e-6  # a Newton step below this that no longer shrinks is rounding: converged
 
 
 class Flow(Protocol):
@@ -74,11 +75,18 @@ class Descent:
     min_spring_length: float  # user units, along the path
 
 
+def newton_done(size: float, last: float, tol: float) -> bool:
+    """Newton's method has converged: its step is below `tol`, or below STALLED and no longer
+    shrinking (the rounding floor of an ill-conditioned minimum, 1e-8 where the Hessian's
+    condition is 1e9; a degenerate minimum's steps still shrink, by 2/3, and go on)."""
+    return size < tol or (size < STALLED and size > 0.9 * last)
+
+
 def descend(flow: Flow, start: np.ndarray, max_steps: int = MAX_STEPS) -> Descent:
     """Gradient flow of V from `start` to a minimum (at most `max_steps` steps)."""
     x = np.array(start, dtype=float)
     path, shortest = [x.copy()], flow.shortest(x)
-    v, step = flow.energy(x), MAX_STEP
+    v, step, last = flow.energy(x), MAX_STEP, np.inf
     for _ in range(max_steps):
         grad = flow.gradient(x)
         newton = flow.newton(x, grad)
@@ -87,9 +95,12 @@ def descend(flow: Flow, start: np.ndarray, max_steps: int = MAX_STEPS) -> Descen
             v = flow.energy(x)
             path.append(x.copy())
             shortest = min(shortest, flow.shortest(x))
-            if np.abs(newton).max() < flow.newton_tol:
+            size = float(np.abs(newton).max())
+            if newton_done(size, last, flow.newton_tol):
                 return Descent(np.array(path), True, shortest)
+            last = size
             continue
+        last = np.inf
         norm = float(np.hypot.reduce(np.abs(grad)))
         if norm == 0:
             break

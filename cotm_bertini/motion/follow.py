@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..analysis.barriers import Flow, descend
+from ..analysis.barriers import Flow, descend, newton_done
 from ..errors import ParameterError
 from ..progress import Progress
 from .path import ActuatorPath
@@ -84,7 +84,7 @@ class Followed:
 def settle(flow: Flow, x: np.ndarray) -> np.ndarray | None:
     """The minimum of V that Newton's method reaches from x (None: the Hessian is not positive
     definite on the way, a step is too long, the state moves too far or Newton stalls)."""
-    y, moved = np.array(x, dtype=float), 0.0
+    y, moved, last = np.array(x, dtype=float), 0.0, np.inf
     for _ in range(NEWTON_ITERATIONS):
         step = flow.newton(y, flow.gradient(y))
         if step is None:
@@ -94,8 +94,9 @@ def settle(flow: Flow, x: np.ndarray) -> np.ndarray | None:
         if size > NEWTON_RANGE or moved > MAX_MOVE:
             return None
         y = flow.move(y, step)
-        if size < flow.newton_tol:
+        if newton_done(size, last, flow.newton_tol):
             return y if flow.newton(y, flow.gradient(y)) is not None else None
+        last = size
     return None
 
 

@@ -425,3 +425,40 @@ def test_a_pitchfork_on_the_path_is_reported_not_chosen():
     assert f.snaps and all(sn.kind == "degenerate" and abs(sn.s - 0.5) < 1e-9 for sn in f.snaps)
     assert len(f.warnings) == len(f.snaps) and all("pitchfork" in w for w in f.warnings)
     assert abs(abs(f.states[-1][0]) - 1.0) < 1e-12  # on one of the two new minima, sqrt(1)
+
+
+def test_a_zero_energy_fold_of_the_paper_is_passed_and_reported():
+    """From L01 = L02 = 3.5 m along L01, the stable state reaches a pose with both springs at
+    their free lengths (V = 0) exactly where their length gradients are parallel: a singular
+    minimum where zero-energy poses are born. Newton on independent equations (d2 = 3.5 m and
+    det d(d1, d2)/d(gamma) = 0, the physics module's lengths, differences for derivatives; the
+    snap's pose only as a first guess) puts it at L01 = d1 there. The move reports it as
+    degenerate and still reaches the path's end (before STALLED it stopped there)."""
+    from physics import points as pts
+
+    p = cb.Params(L01=3.5, L02=3.5)
+    res = cb.solve(p)
+    (sid,) = res.stable.solution_id  # one stable state there
+    mv = move(res, int(sid), {"L01": [3.5, 10.5]})
+    assert mv.table.s.iloc[-1] == 1.0 and set(mv.snaps.kind) == {"degenerate"}
+    assert mv.status == "incomplete" and all("pitchfork" in w for w in mv.warnings)
+
+    def lengths(g):
+        q = pts(p, *g)
+        return np.array([np.linalg.norm(q[6] - q[2]), np.linalg.norm(q[5] - q[3])])
+
+    def jac(g, h=1e-6):
+        return np.array([(lengths(g + h * e) - lengths(g - h * e)) / (2 * h) for e in np.eye(2)]).T
+
+    def equations(g):  # d2 = L02 and the springs' length gradients parallel
+        return np.array([lengths(g)[1] - 3.5, np.linalg.det(jac(g))])
+
+    snap = mv.snaps.iloc[0]
+    g = np.radians([snap["before.gamma1_deg"], snap["before.gamma2_deg"]])  # a first guess only
+    for _ in range(40):  # Newton on the independent equations, derivatives by differences
+        h = 1e-5
+        J = np.array([(equations(g + h * e) - equations(g - h * e)) / (2 * h) for e in np.eye(2)]).T
+        g = g - np.linalg.solve(J, equations(g))
+    assert np.abs(equations(g)).max() < 1e-8
+    d1 = lengths(g)[0]
+    assert abs(mv.snaps.L01.iloc[0] - d1) < 1e-6, (list(mv.snaps.L01), d1)

@@ -1,9 +1,21 @@
 """The term-vectorised polynomial systems (model/polynomial.py) against sympy."""
 
 import numpy as np
+import pytest
 import sympy as sp
 
+from cotm_bertini.model import polynomial
 from cotm_bertini.model.symbolic import parametric_from_sympy
+
+# Both evaluation routes: the coefficient table (small systems) and the sparse terms (large).
+ROUTES = pytest.mark.parametrize("route", ["table", "sparse"])
+
+
+def _route(monkeypatch, route: str, poly) -> None:
+    """Make `poly` evaluate by `route`, and check that it does."""
+    if route == "sparse":
+        monkeypatch.setattr(polynomial, "TABLE_LIMIT", 0)
+    assert (poly._table is None) == (route == "sparse")
 
 
 def _random_system(rng, n_vars: int = 6, n_funcs: int = 5, terms: int = 40):
@@ -19,7 +31,8 @@ def _random_system(rng, n_vars: int = 6, n_funcs: int = 5, terms: int = 40):
     return xs, funcs
 
 
-def test_jacobian_matches_sympy_also_where_coordinates_vanish():
+@ROUTES
+def test_jacobian_matches_sympy_also_where_coordinates_vanish(monkeypatch, route):
     """PolySystem.jacobian (products of the other factors from prefix and suffix products)
     equals sympy's derivative, at random complex points and at points with zero coordinates
     (where a quotient rule would divide by zero)."""
@@ -27,6 +40,7 @@ def test_jacobian_matches_sympy_also_where_coordinates_vanish():
     xs, funcs = _random_system(rng)
     names = tuple(f"f{i}" for i in range(len(funcs)))
     poly = parametric_from_sympy(tuple(x.name for x in xs), names, tuple(funcs), ()).instantiate([])
+    _route(monkeypatch, route, poly)
     jac = sp.lambdify(xs, sp.Matrix(funcs).jacobian(xs), "numpy")
     z = rng.normal(size=(4, len(xs))) + 1j * rng.normal(size=(4, len(xs)))
     z[1, 0] = 0.0
@@ -39,13 +53,15 @@ def test_jacobian_matches_sympy_also_where_coordinates_vanish():
         assert np.allclose(ours[k], theirs, rtol=1e-12, atol=1e-12 * np.abs(theirs).max())
 
 
-def test_value_and_jacobian_is_evaluate_and_jacobian():
+@ROUTES
+def test_value_and_jacobian_is_evaluate_and_jacobian(monkeypatch, route):
     """The one-pass value_and_jacobian gives evaluate's values (sympy's, through lambdify) and
     the same Jacobian."""
     rng = np.random.default_rng(5)
     xs, funcs = _random_system(rng, n_vars=4, n_funcs=3, terms=25)
     names = tuple(f"f{i}" for i in range(len(funcs)))
     poly = parametric_from_sympy(tuple(x.name for x in xs), names, tuple(funcs), ()).instantiate([])
+    _route(monkeypatch, route, poly)
     z = rng.normal(size=(3, len(xs))) + 1j * rng.normal(size=(3, len(xs)))
     z[2, 1] = 0.0
     values, jac = poly.value_and_jacobian(z)

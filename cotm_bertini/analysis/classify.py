@@ -107,6 +107,10 @@ def merge_endpoints(
     jac_cond = np.where(np.isfinite(jac_cond), jac_cond, np.inf)
     singular = (jac_cond > tol.singular_condition) | (endpoints.bertini_multiplicity > 1) | snapped
     labels = cluster_endpoints(x, singular, acc, tol.merge)
+    if np.array_equal(labels, np.arange(len(labels))):  # every endpoint its own solution
+        paths = [str(int(p)) for p in endpoints.path_number]
+        return Merged(x, np.ones(len(x), dtype=int), paths, np.asarray(endpoints.condition_number,
+                      dtype=float), jac_cond, singular.astype(bool), acc)  # fmt: skip
     groups = [np.flatnonzero(labels == g) for g in range(labels.max() + 1 if len(labels) else 0)]
     best = np.array([m[np.argmin(res[m])] for m in groups], dtype=int)
     return Merged(

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..model.pointsets import apart
+
 
 def cluster_endpoints(
     x: np.ndarray, singular: np.ndarray, accuracy: np.ndarray, tol: float
@@ -20,10 +22,14 @@ def cluster_endpoints(
         return labels
     mag = 1.0 + np.abs(x).max(axis=1)
     loose = np.where(singular, 10.0 * np.sqrt(np.maximum(accuracy, 1e-16)), tol)
+    if apart(x, max(tol, loose.max()) * mag.max()):  # no pair within the loosest limit
+        return np.arange(n)
     gap = np.abs(x[:, None, :] - x[None, :, :]).max(axis=2)
     both = singular[:, None] & singular[None, :]
     limit = np.where(both, np.maximum(loose[:, None], loose[None, :]), tol)
     same = gap <= limit * np.maximum(mag[:, None], mag[None, :])
+    if np.count_nonzero(same) == n and same.diagonal().all():  # each only with itself
+        return np.arange(n)
     group = 0
     for i in range(n):
         if labels[i] >= 0:

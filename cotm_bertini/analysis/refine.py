@@ -10,28 +10,30 @@ from ..params import Params
 
 
 def newton_refine(system: PolySystem, x: np.ndarray, steps: int) -> tuple[np.ndarray, np.ndarray]:
-    """A few complex Newton steps, each kept only where it lowers the residual."""
+    """A few complex Newton steps, each kept only where it lowers the residual; a point whose
+    step is at rounding level (or was not kept) is done: its next step would be the same."""
     x = np.array(x, dtype=complex)
     scale = system.scale()
     res = np.abs(system.evaluate(x) / scale).max(axis=1)
+    active = np.arange(len(x))
     for _ in range(steps):
-        f, jac = system.value_and_jacobian(x)
-        step = np.zeros_like(x)
+        xa = x[active]
+        f, jac = system.value_and_jacobian(xa)
+        step = np.zeros_like(xa)
         ok = np.isfinite(jac).all(axis=(1, 2))
         try:
             step[ok] = np.linalg.solve(jac[ok], f[ok][..., None])[..., 0]
         except np.linalg.LinAlgError:  # an exactly singular matrix: solve only the sound ones
             ok &= np.linalg.cond(jac) < 1e14
             step[ok] = np.linalg.solve(jac[ok], f[ok][..., None])[..., 0]
-        ok &= np.isfinite(step).all(axis=1)
-        if not (np.abs(step[ok]) > 4e-14 * (1 + np.abs(x[ok]))).any():
-            break  # converged to rounding: a further step cannot lower the residual
-        trial = x - np.where(ok[:, None], step, 0)
-        new = np.abs(system.evaluate(trial) / scale).max(axis=1)
-        better = ok & (new < res)
-        x[better] = trial[better]
-        res[better] = new[better]
-        if not better.any():
+        # converged to rounding where no coordinate moves by more than 4e-14 relative
+        ok &= np.isfinite(step).all(axis=1) & (np.abs(step) > 4e-14 * (1 + np.abs(xa))).any(axis=1)
+        active, trial = active[ok], xa[ok] - step[ok]
+        new = np.abs(system.evaluate(trial) / scale).max(axis=1) if len(trial) else res[:0]
+        better = new < res[active]
+        active = active[better]
+        x[active], res[active] = trial[better], new[better]
+        if not len(active):
             break
     return x, res
 

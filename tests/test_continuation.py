@@ -42,6 +42,28 @@ def test_continued_point_equals_the_generic_route(step, method, newton, monkeypa
     assert b.counts["stable"] == fresh.counts["stable"]
 
 
+def test_a_path_double_precision_cannot_finish_is_retracked(monkeypatch):
+    """L02 12.88 -> 12.74 at L01 = 8.26 (case 3): one real root passes next to a cone point (d2
+    near 0; -1.3e-3 m at the target), ill-conditioned there, and its path fails in double
+    precision. It is
+    tracked again in adaptive precision, not the whole point solved from the generic set; the
+    answer equals an ab-initio total-degree solve by the bertini2 command."""
+    a = solve_point(Params.case("case3", L01=8.26, L02=12.88))
+    monkeypatch.setattr(target, "newton_continue", lambda *a: (None, "off for this test"))
+    b = solve_point(Params.case("case3", L01=8.26, L02=12.74), warm=a.warm)
+    info = b.details["homotopy"]
+    assert info["method"] == SEGMENT + " + adaptive retrack"
+    assert info["retracked_adaptive"] == 1 and info["lost"] == 0
+    fresh = solve_point(Params.case("case3", L01=8.26, L02=12.74), Settings(engine="cli"))
+    assert len(b.table) == len(fresh.table) and b.status == fresh.status == "ok"
+    assert np.abs(_angles(b.table) - _angles(fresh.table)).max() < 1e-6
+    tiny = [
+        t.loc[(t["d2"].abs() < 1e-2) & (t["reason"] != "zero_length_spring"), "d2"].to_numpy()
+        for t in (b.table, fresh.table)
+    ]
+    assert len(tiny[0]) == len(tiny[1]) == 1 and abs(tiny[0][0] - tiny[1][0]) < 1e-9
+
+
 def test_newton_starts_a_line_of_points_from_the_secant():
     """Points on a line: the third is started from the secant through the first two (closer
     than the second point's roots are), and what Newton finds from there is still checked."""

@@ -17,6 +17,7 @@ import numpy as np
 
 from ..errors import SolverError
 from ..model.compiled import polynomial_system
+from ..model.pointsets import apart
 from ..model.polynomial import ParametricSystem
 from ..params import Params
 from ..settings import Settings
@@ -101,6 +102,14 @@ def continue_from(
     }
     text = render_parameter_homotopy(sub, start, target, detour, texts)
     meta, pts = _run_homotopy(sub, text, warm.points, target, settings, deadline)
+    # A path double precision cannot finish (one ending next to a spring of length ~1e-4, where
+    # the root is ill-conditioned) is tracked again in adaptive precision, as `track` does.
+    redo = [i for i, m in enumerate(meta) if _code(m) != _SUCCESS or not m.is_finite]
+    if redo:
+        again = _run_homotopy(sub, text, warm.points[redo], target, settings, deadline, "adaptive")
+        meta, pts = list(meta), list(pts)
+        for i, m, p in zip(redo, *again, strict=True):
+            meta[i], pts[i] = m, p
     rows, failed = [], 0
     for i, (m, p) in enumerate(zip(meta, pts, strict=True)):
         if _code(m) == _SUCCESS and m.is_finite:
@@ -114,8 +123,9 @@ def continue_from(
         return None, "a path ended at a singular point"
     if _crossing(results, list(results)):
         return None, "two paths ended at the same point"
-    rep = TrackReport(tracked=len(pts), finite=len(rows), method="continued")
-    info = {**rep.as_dict(), "method": "continued from the neighbouring point", "moved": free}
+    rep = TrackReport(len(pts), len(rows), retracked_adaptive=len(redo), method="continued")
+    method = "continued from the neighbouring point" + (" + adaptive retrack" if redo else "")
+    info = {**rep.as_dict(), "method": method, "moved": free}
     return (Endpoints.from_records(ps.variables, rows), info, text), ""
 
 
@@ -132,8 +142,11 @@ def _fixed_system(ps: ParametricSystem, key: str, fixed: tuple) -> tuple:
     return _FIXED[key, fixed]
 
 
-def _run_homotopy(sub, text: str, points, target: dict, settings: Settings, deadline):
-    """Track `points` along the homotopy `text` in double precision with large steps."""
+def _run_homotopy(
+    sub, text: str, points, target: dict, settings: Settings, deadline, mptype: str = "double"
+):
+    """Track `points` along the homotopy `text` with large steps (in double precision, or
+    `mptype`)."""
     bertini = _bertini()
     from bertini import nag_algorithm as na
 
@@ -141,8 +154,8 @@ def _run_homotopy(sub, text: str, points, target: dict, settings: Settings, dead
     with solver_errors(f"the continuation from the neighbouring point ({len(points)} paths)"):
         hom = bertini.parse.system(text)
         tgt = bertini.parse.system(render_system(system))
-        solver = na.HomotopySolver(hom, list(points), tgt, mptype="double")
-        _configure(solver, settings, "double", deadline, max([1.0, *map(abs, target.values())]))
+        solver = na.HomotopySolver(hom, list(points), tgt, mptype=mptype)
+        _configure(solver, settings, mptype, deadline, max([1.0, *map(abs, target.values())]))
         solver.set(**{k: bertini.multiprec.real_mp(v) for k, v in _CONTINUATION_STEPS.items()})
         solver.solve(show_progress=False)
     if deadline is not None and time.perf_counter() > deadline:
@@ -159,6 +172,7 @@ _ACCEPTED = 1e-10  # ... and is a root when its last step is below this (1e-4 of
 _RESIDUAL = 1e-12  # |f| relative to the coefficients
 _DISTINCT = 1e-6  # two endpoints closer than this (relative) are one: not a complete set
 _CONDITION = 1e8  # a Jacobian worse conditioned than this: not provably nonsingular
+_NEARLY_SINGULAR = "a root is nearly singular"
 _SUBSTEPS = (2, 4)  # when one step fails: Newton along this many equal steps to the target,
 _DETOUR_STEPS = 8  # then along this many steps of an arc into complex parameters (past folds)
 _DETOUR = 0.5 + 0.5j  # the arc's largest excursion, relative to the step between the points
@@ -202,6 +216,8 @@ def newton_continue(
         if not why:
             break
         first = first or why
+        if why == _NEARLY_SINGULAR:  # N distinct roots, so every root: no attempt does better
+            return None, first
     else:
         return None, first
     records = [
@@ -296,11 +312,12 @@ def _newton_refusal(system, x: np.ndarray, size: np.ndarray) -> tuple[str, np.nd
     residual = (np.abs(system.evaluate(x)) / (system.scale() * grow)).max(axis=1)
     if residual.max() > _RESIDUAL:
         return "a Newton endpoint is not a root", residual, nothing
-    gaps = np.abs(x[:, None, :] - x[None, :, :]).max(axis=2) / (1 + np.abs(x).max())
-    np.fill_diagonal(gaps, np.inf)
-    if gaps.min() < _DISTINCT:
-        return "two starts converged to one root", residual, nothing
+    if not apart(x, _DISTINCT * (1 + np.abs(x).max())):  # then compare every pair
+        gaps = np.abs(x[:, None, :] - x[None, :, :]).max(axis=2) / (1 + np.abs(x).max())
+        np.fill_diagonal(gaps, np.inf)
+        if gaps.min() < _DISTINCT:
+            return "two starts converged to one root", residual, nothing
     cond = np.linalg.cond(system.jacobian(x))
     if (cond > _CONDITION).any():
-        return "a root is nearly singular", residual, cond
+        return _NEARLY_SINGULAR, residual, cond
     return "", residual, cond

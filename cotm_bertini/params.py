@@ -143,10 +143,14 @@ class Params:
 
         Its equilibria have the same angles; its spring lengths are the originals divided by L3.
         """
-        k = max(self.k1, self.k2)
-        return Params(
-            **{n: v / (self.L3 if n in LENGTHS else k) for n, v in self.as_dict().items()}
-        )
+        done = self.__dict__.get("_normalized")  # kept: a sweep's point asks for it many times
+        if done is None:
+            k = max(self.k1, self.k2)
+            done = Params(
+                **{n: v / (self.L3 if n in LENGTHS else k) for n, v in self.as_dict().items()}
+            )
+            object.__setattr__(self, "_normalized", done)
+        return done
 
 
 def validate(p: Params) -> None:

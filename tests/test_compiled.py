@@ -63,7 +63,8 @@ def test_generated_energy_code_matches_sympy_and_numpy():
 
 
 def test_tan_half_jacobian_matches_sympy():
-    """The generated Jacobians of the paper's tan-half equations equal sympy's."""
+    """The Jacobians of the paper's tan-half equations (evaluated from their terms) equal
+    sympy's."""
     rng = np.random.default_rng(9)
     for zfl in equations.ZFL_PATTERNS:
         p = make_params(None, {"L01": 0.0 if zfl[0] else 7.0, "L02": 0.0 if zfl[1] else 9.0})

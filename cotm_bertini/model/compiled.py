@@ -1,9 +1,10 @@
 """The derived equations as fast numeric code, cached on disk so a solve needs no sympy.
 
 `equations` (sympy) is the source of truth. What it derives is kept in the cache folder: each
-structure's ParametricSystem as JSON, and the energy, its gradient and Hessian and the paper's
-tan-half Jacobians as a generated Python module. The cache key is a hash of the derivation's
-source (equations.py, kinematics.py), so an edit of either regenerates them.
+structure's ParametricSystem and the paper's tan-half system (whose Jacobian is its stability
+criterion) as JSON, and the energy, its gradient and Hessian as a generated Python module. The
+cache key is a hash of the derivation's source (equations.py, kinematics.py), so an edit of
+either regenerates them.
 """
 
 from __future__ import annotations
@@ -43,15 +44,27 @@ def _write(path: Path, text: str) -> None:
 @cache
 def parametric_system(zfl: tuple[bool, bool]) -> ParametricSystem:
     """The structure's equations as numbers (from the disk cache, or derived with sympy)."""
-    path = cache_root() / "equations" / f"system-{_source_hash()}-{_tag(zfl)}.json"
+    from .equations import derive_parametric
+
+    return _cached_system("system", zfl, derive_parametric)
+
+
+@cache
+def tan_half_parametric(zfl: tuple[bool, bool]) -> ParametricSystem:
+    """The paper's tan-half equations (F, tau, C1, C2 in x1, x2, d1, d2) as numbers."""
+    from .equations import derive_tan_half
+
+    return _cached_system("tanhalf", zfl, derive_tan_half)
+
+
+def _cached_system(kind: str, zfl: tuple[bool, bool], derive) -> ParametricSystem:
+    path = cache_root() / "equations" / f"{kind}-{_source_hash()}-{_tag(zfl)}.json"
     if path.is_file():
         try:
             return ParametricSystem.from_json(json.loads(path.read_text()))
         except (ValueError, KeyError):
             pass  # damaged: derive again
-    from .equations import derive_parametric
-
-    ps = derive_parametric(zfl)
+    ps = derive(zfl)
     _write(path, json.dumps(ps.to_json()))
     return ps
 
@@ -122,11 +135,8 @@ def energy_hessian(params: Params, g1, g2) -> np.ndarray:
 def tan_half_jacobian(params: Params, point: tuple) -> np.ndarray:
     """Jacobian of the paper's equations (F, tau, C1, C2) in (x1, x2, d1, d2): one point of
     scalars -> (m, m); or arrays of n points -> (n, m, m)."""
-    fn = getattr(_generated(), f"tan_half_jacobian_{_tag(params.zfl)}")
-    arrays = [np.asarray(v) for v in point]
-    shape = np.broadcast_shapes(*(a.shape for a in arrays))
-    rows = fn(*arrays, *_values(params))
-    jac = np.array(
-        [[np.broadcast_to(np.asarray(v, dtype=complex), shape) for v in row] for row in rows]
-    )
-    return np.moveaxis(jac, (0, 1), (-2, -1))
+    ps = tan_half_parametric(params.zfl)
+    system = ps.instantiate([getattr(params, n) for n in ps.parameters])
+    arrays = np.broadcast_arrays(*(np.asarray(v, dtype=complex) for v in point))
+    jac = system.jacobian(np.stack([a.ravel() for a in arrays], axis=-1))
+    return jac.reshape(*arrays[0].shape, *jac.shape[1:])

@@ -131,6 +131,15 @@ def tan_half_system(zfl: tuple[bool, bool]) -> tuple[tuple[sp.Symbol, ...], tupl
     return variables, eqs
 
 
+def derive_tan_half(zfl: tuple[bool, bool]) -> ParametricSystem:
+    """`tan_half_system` as numbers (its Jacobian is the paper's stability criterion's)."""
+    from .symbolic import parametric_from_sympy
+
+    variables, eqs = tan_half_system(zfl)
+    names = tuple(f"th{k + 1}" for k in range(len(eqs)))
+    return parametric_from_sympy(tuple(v.name for v in variables), names, eqs, PARAM_NAMES)
+
+
 ZFL_PATTERNS = ((True, True), (False, True), (True, False), (False, False))
 
 
@@ -142,8 +151,8 @@ def _source(name: str, args: tuple, expr) -> str:
 
 
 def generated_source() -> str:
-    """Python source of the numeric functions (energy, gradient, Hessian, tan-half Jacobians),
-    from sympy's lambdify: it is written to the cache so later runs need no sympy."""
+    """Python source of the numeric functions (energy, gradient, Hessian), from sympy's
+    lambdify: it is written to the cache so later runs need no sympy."""
     V, grad, hess = energy_expressions()
     args = (G1, G2, *P)
     parts = [
@@ -151,12 +160,6 @@ def generated_source() -> str:
         _source("gradient", args, grad),
         _source("hessian", args, hess),
     ]
-    for zfl in ZFL_PATTERNS:
-        variables, eqs = tan_half_system(zfl)
-        jac = sp.Matrix(eqs).jacobian(variables)
-        tag = "".join("T" if z else "F" for z in zfl)
-        # Nested lists, not a Matrix: lambdify then broadcasts over arrays of points.
-        parts.append(_source(f"tan_half_jacobian_{tag}", (*variables, *P), jac.tolist()))
     body = "\n\n".join(parts) + "\n"
     # Import only the numpy names the code calls: `from numpy import *` costs ~50 ms a process.
     called = set(re.findall(r"\b([A-Za-z_]\w*)\(", body))

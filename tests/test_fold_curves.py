@@ -113,6 +113,25 @@ def test_stable_count_changes_only_across_fold_curves(folds):
     assert missed.empty, missed
 
 
+def test_fold_curves_beside_the_sweep_are_the_same(monkeypatch):
+    """With two workers the paper's fold curves are computed in a process of their own beside
+    the sweep's set-up; the map is the one a single worker makes (which starts no such
+    process: the workers setting is honoured)."""
+    from cotm_bertini.api import maps
+
+    window = ((9.0, 13.0), (0.5, 4.5))
+    two = cb.design_map(P, *window, 3, workers=2)
+
+    def refused(job):
+        raise AssertionError("a second process with workers = 1")
+
+    monkeypatch.setattr(maps, "_FoldsAside", refused)
+    one = cb.design_map(P, *window, 3, workers=1)
+    pd.testing.assert_frame_equal(two.folds, one.folds)
+    pd.testing.assert_frame_equal(two.regions, one.regions)
+    assert len(two.folds) > 100 and two.record["timings"]["folds"] > 0
+
+
 def _map_cli(*args: str) -> subprocess.CompletedProcess:
     cmd = [sys.executable, "-m", "cotm_bertini.cli", "map", "--quiet", *args]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=600)

@@ -118,8 +118,7 @@ def design_map(
     xs, ys = grid_values(*xr, points), grid_values(*yr, points)
     if aside is None:
         folds, fold_record, t_folds = _timed_folds(job)
-        n = int((folds.physical.astype(bool) & folds[x].between(*xr) & folds[y].between(*yr)).sum())
-        say(f"map: {n} fold points in {duration(t_folds)}; now the stable counts on a "
+        say(f"map: {len(folds)} fold points in {duration(t_folds)}; now the stable counts on a "
             f"{points} x {points} grid (a 2-D sweep)")  # fmt: skip
     else:
         say(f"map: ... and beside them the stable counts on a {points} x {points} grid")
@@ -127,17 +126,14 @@ def design_map(
     try:
         sw = sweep(model, x, xs, settings, param2=y, values2=ys, workers=workers,
                    progress=progress)  # fmt: skip
-        done = aside.result() if aside is not None else None
+        if aside is not None:
+            folds, fold_record, t_folds = aside.result()
     finally:
         if aside is not None:
             aside.close()
     regions = counts_on_grid(sw.columns, xs, ys, (x, y))
     t_regions = time.perf_counter() - t1
-    if done is not None:
-        folds, fold_record, t_folds = done
-    inside = folds.physical.astype(bool) & folds[x].between(*xr) & folds[y].between(*yr)
-    folds = folds[inside].reset_index(drop=True)
-    if done is not None:
+    if aside is not None:
         say(f"map: {len(folds)} fold points in {duration(t_folds)} (beside the sweep)")
     pieces = int(folds.curve_id[folds.curve_id >= 0].nunique())
     record = {
@@ -158,10 +154,12 @@ def design_map(
 
 
 def _timed_folds(job: tuple) -> tuple:
-    """fold_points(*job) and its seconds."""
+    """fold_points(*job) kept to its physical points in the window, its record and seconds."""
     start = time.perf_counter()
     folds, record = fold_points(*job)
-    return folds, record, time.perf_counter() - start
+    _, x, xr, y, yr = job[:5]
+    inside = folds.physical.astype(bool) & folds[x].between(*xr) & folds[y].between(*yr)
+    return folds[inside].reset_index(drop=True), record, time.perf_counter() - start
 
 
 class _FoldsAside:

@@ -307,9 +307,10 @@ def _newton_refusal(system, x: np.ndarray, size: np.ndarray) -> tuple[str, np.nd
     nothing = np.zeros(0)
     if not np.isfinite(x).all() or not (size < _ACCEPTED).all():
         return "Newton did not converge on every start", nothing, nothing
+    values, jac = system.value_and_jacobian(x)  # one pass: the Jacobian is asked for below
     # |f_i| relative to its coefficients and to the size of the point (degree d_i).
     grow = (1 + np.abs(x).max(axis=1))[:, None] ** np.array(system.degrees)[None, :]
-    residual = (np.abs(system.evaluate(x)) / (system.scale() * grow)).max(axis=1)
+    residual = (np.abs(values) / (system.scale() * grow)).max(axis=1)
     if residual.max() > _RESIDUAL:
         return "a Newton endpoint is not a root", residual, nothing
     if not apart(x, _DISTINCT * (1 + np.abs(x).max())):  # then compare every pair
@@ -317,7 +318,7 @@ def _newton_refusal(system, x: np.ndarray, size: np.ndarray) -> tuple[str, np.nd
         np.fill_diagonal(gaps, np.inf)
         if gaps.min() < _DISTINCT:
             return "two starts converged to one root", residual, nothing
-    cond = np.linalg.cond(system.jacobian(x))
+    cond = np.linalg.cond(jac)
     if (cond > _CONDITION).any():
         return _NEARLY_SINGULAR, residual, cond
     return "", residual, cond

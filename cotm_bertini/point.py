@@ -216,6 +216,8 @@ def solve_framework_point(
     with t.stage("derive"):
         # Free even with every cable taut: a continuum of equilibria, refused as bad input.
         check_mobility(fw, framework_system(fw, tuple(c.name for c in fw.cables)))
+    if framework_route(fw, settings) == "real":
+        return _solve_real(fw, settings, tolerances, t)
     unit = units(fw)
     target, centre = normalized_slots(fw), normalized_slots(fw.at_defaults())
     parts, report, texts, starts = [], {}, [], {}
@@ -243,6 +245,92 @@ def solve_framework_point(
         fw, settings, table, None, counts, checks["morse"], status, tuple(checks["warnings"]),
         engine, shape, {"taut_sets": report}, "\n".join(texts), t.stages, starts,
     )  # fmt: skip
+
+
+def framework_route(fw, settings: Settings) -> str:
+    """'real' or 'complex': the route asked for, or by default the real one wherever it covers
+    the configuration space (a refusal names why it cannot where 'real' was asked for)."""
+    from .backends.real_route import covers
+
+    why = covers(fw)
+    if settings.route == "real" and why:
+        raise ParameterError(f"route = 'real': not yet for {fw.name}: {why}; use route='complex'")
+    if settings.route is not None:
+        return settings.route
+    return "complex" if why or settings.generic or settings.scheduler else "real"
+
+
+def _solve_real(fw, settings: Settings, tolerances: Tolerances, t: Timings) -> PointSolution:
+    """Every real equilibrium of a framework on a circle or torus, by the branch and bound of
+    backends.boxes over its body angles (backends.real_route), classified as the complex route's
+    endpoints are; the search's proof (or what it left undecided) is the completeness check."""
+    from .analysis.framework_checks import completeness, framework_counts, order_rows
+    from .analysis.framework_classify import framework_columns
+    from .backends.boxes import MIN_WIDTH, SHORT, search
+    from .backends.real_route import TorusFramework
+    from .model.framework.compiled import framework_system
+    from .model.framework.units import units
+
+    unit = units(fw)
+    sets, pruned = split_taut_sets(fw)
+    with t.stage("derive"):
+        land = TorusFramework(fw)
+        _ = land.hessian_sets  # derived (or loaded) here, not inside the search's clock
+    with t.stage("solve"):
+        found = search(land, SHORT, MIN_WIDTH, max_seconds=settings.timeout,
+                       label=f"real search of {fw.name}")  # fmt: skip
+        groups = land.endpoints(found.roots)
+    report: dict = {" ".join(taut) or "none": {"excluded": True, "pruned": "bound smoothing",
+                    "note": why.note()} for taut, why in pruned.items()}  # fmt: skip
+    parts = []
+    with t.stage("classify"):
+        for taut in sets + [g for g in groups if g not in sets]:
+            eps = groups.get(taut)
+            report[" ".join(taut) or "none"] = {"route": "real", "roots": len(eps or ())}
+            if eps is not None:
+                parts.append(framework_columns(fw, framework_system(fw, taut), eps, unit,
+                                               tolerances))  # fmt: skip
+        table = order_rows(fw, parts)
+        checks = completeness(fw, table, report)
+    search_info = real_search_info(found, unit[0])
+    warnings = tuple(search_info["warnings"] + checks["warnings"])
+    counts = {**framework_counts(table, report), "boxes": found.boxes}
+    engine = {"flavour": "real", "path": "branch and bound (backends.boxes)", "version": ""}
+    shape = {"taut_sets": list(report), "units": {"length": unit[0], "stiffness": unit[1]}}
+    return PointSolution(
+        fw, settings, table, None, counts, checks["morse"],
+        STATUS_INCOMPLETE if warnings else STATUS_OK, warnings, engine, shape,
+        {"taut_sets": report, "real_search": search_info}, "", t.stages, None,
+    )  # fmt: skip
+
+
+def real_search_info(found, length_unit: float) -> dict:
+    """The real search's record for run.json: what was decided, set aside and left, and the
+    warnings a search that is not a proof gives."""
+    warnings = []
+    if len(found.undecided):
+        warnings.append(
+            f"the real search left {len(found.undecided)} boxes undecided "
+            f"({found.undecided_share:.3g} of the configuration space"
+            f"{'; ' + found.budget_hit if found.budget_hit else ''}): equilibria may be missing "
+            "there"
+        )
+    if found.newton_failed:
+        warnings.append(f"{found.newton_failed} proved critical points not reached by Newton")
+    return {
+        "boxes": found.boxes,
+        "seconds": round(found.seconds, 4),
+        "roots": len(found.roots),
+        "set_aside": found.set_aside,
+        "set_aside_longest_spring": found.set_aside_bound * length_unit,
+        "shortest_spring": (
+            None if not np.isfinite(found.shortest_length) else found.shortest_length * length_unit
+        ),  # fmt: skip
+        "undecided": len(found.undecided),
+        "undecided_share": found.undecided_share,
+        "undecided_boxes_deg": np.degrees(found.undecided[:20]).round(6).tolist(),
+        "warnings": warnings,
+    }
 
 
 def taut_sets(fw) -> list[tuple[str, ...]]:

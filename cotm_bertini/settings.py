@@ -28,6 +28,7 @@ CONFIG_KEYS = {
 }
 
 ENGINES = ("homotopy", "cli")
+ROUTES = (None, "real", "complex")
 GENERIC_ROUTES = (None, "monodromy", "total-degree", "both")
 DEFAULT_CLI_TIMEOUT = 600.0
 
@@ -65,6 +66,11 @@ class Settings:
     # How a generic set is found (backends/generic.py): "monodromy", "total-degree" or "both";
     # None: backends.generic.DEFAULT_ROUTE (monodromy; total-degree with a scheduler).
     generic: str | None = None
+    # How a framework is solved (docs/frameworks.md, "The real route"): "real" (branch and bound
+    # over the configuration space, real critical points only), "complex" (every complex root of
+    # every taut set: generic sets and parameter homotopy); None: the real route where it covers
+    # the configuration space, else the complex one.
+    route: str | None = None
 
     def __new__(cls, *args: object, **values: object) -> Settings:
         """Refuse an unknown setting with ParameterError (not a bare TypeError)."""
@@ -100,6 +106,13 @@ class Settings:
         if self.generic not in GENERIC_ROUTES:
             raise ParameterError(
                 f"generic = {self.generic!r}: expected 'monodromy', 'total-degree' or 'both'"
+            )
+        if self.route not in ROUTES:
+            raise ParameterError(f"route = {self.route!r}: expected 'real' or 'complex'")
+        if self.route == "real" and self.generic is not None:
+            raise ParameterError(
+                f"generic = {self.generic!r} with route = 'real': the real route solves no "
+                "generic set (route='complex' does)"
             )
         if self.engine == "homotopy":
             self._refuse_cli_only()
@@ -169,7 +182,7 @@ class Settings:
         """All settings, for run.json and cache keys (`scheduler` only when set, so that the
         sweep specs and keys written before it existed still match)."""
         out = asdict(self)
-        for name in ("scheduler", "generic"):  # absent when unset: older keys still match
+        for name in ("scheduler", "generic", "route"):  # absent when unset: older keys match
             if out[name] is None:
                 del out[name]
         return out

@@ -79,7 +79,7 @@ def framework_counts(table: dict, report: dict) -> dict:
         "singular": int(np.sum(table["singular"])),
         "taut_sets_solved": len(solved),
         "taut_sets_continuum": sum(
-            "tracked" not in r and "pruned" not in r for r in report.values()
+            "tracked" not in r and "pruned" not in r and "route" not in r for r in report.values()
         ),
         "taut_sets_pruned": sum("pruned" in r for r in report.values()),
     }
@@ -89,6 +89,8 @@ def completeness(fw: Framework, table: dict, report: dict) -> dict:
     """Why no equilibrium is missing, or warnings saying why one may be: {"morse", "warnings"}."""
     warnings = []
     for label, info in report.items():
+        if info.get("route") == "real":  # the search's own record says what it left
+            continue
         if "tracked" not in info:
             if not info["excluded"]:
                 warnings.append(f"taut set {label}: {info['note']}")

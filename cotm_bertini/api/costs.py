@@ -91,6 +91,12 @@ class Cost:
 
     def headline(self) -> str:
         """One line: the total work and its estimate (the first line of a solve)."""
+        if self.route == "real":
+            return (
+                f"{self.name}: the real route (a branch and bound over its body angles, real "
+                "equilibria only, proved complete; no generic set to solve: seconds, not paths; "
+                "--route complex solves every complex root of every taut set instead)"
+            )
         solved = [s for s in self.sets if not s.free]
         counts = sorted({s.paths for s in solved})
         per = "+".join(str(s.paths) for s in solved) if len(solved) <= 4 else (
@@ -144,6 +150,8 @@ class Cost:
 
     def lines(self) -> list[str]:
         """The statement `params --framework` prints: per taut set, then the total."""
+        if self.route == "real":
+            return [f"# {self.headline()}"]
         out = [f"# work of a first solve of {self.name} (seed {self.seeds[0]}):"]
         for s in self.sets:
             if s.free:
@@ -198,8 +206,11 @@ def cost(fw, settings: Settings | None = None, *, sample: bool | None = True) ->
     from ..backends.generic import route_of
     from ..backends.homotopy import SECOND_START
     from ..backends.path_progress import first_guess, remember
+    from ..point import framework_route
 
     settings = settings or Settings()
+    if framework_route(fw, settings) == "real":
+        return Cost(fw.name, (), (settings.seed,), 0.0, "no generic set", False, 0.0, "real")
     route = route_of(settings)
     # "both": the total-degree set of the seed itself is the one counted (and a monodromy set).
     one = route in ("monodromy", "both")
@@ -277,7 +288,7 @@ def announce(fw, settings: Settings) -> Cost | None:
     if not enabled() or settings.engine != "homotopy":  # another engine is refused at once
         return None
     c = cost(fw, settings, sample=None)
-    if c.estimate < ANNOUNCE_SECONDS:
+    if c.route == "real" or c.estimate < ANNOUNCE_SECONDS:
         return c
     say(f"cotm-bertini: {c.headline()}")
     if c.over_an_hour:

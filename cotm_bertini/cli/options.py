@@ -84,6 +84,13 @@ def add_route(p: argparse.ArgumentParser) -> None:
         "start, two seeds agree (the route with --scheduler); or both (the monodromy set "
         "checked against the total-degree one)",
     )
+    p.add_argument(
+        "--route",
+        choices=("real", "complex"),
+        help="how a framework is solved: real (branch and bound over its body angles, real "
+        "equilibria only, proved complete; circles and tori) or complex (every complex root of "
+        "every taut set); default: real where it covers the configuration space",
+    )
 
 
 def add_settings(p: argparse.ArgumentParser) -> None:
@@ -207,7 +214,16 @@ def settings_from(args: argparse.Namespace) -> Settings:
     """Settings from the options the user gave (the others stay at their defaults)."""
     given = {
         name: getattr(args, name)
-        for name in ("seed", "engine", "mptype", "timeout", "threads", "bertini", "generic")
+        for name in (
+            "seed",
+            "engine",
+            "mptype",
+            "timeout",
+            "threads",
+            "bertini",
+            "generic",
+            "route",
+        )
         if getattr(args, name, None) is not None
     }
     return Settings(**given)

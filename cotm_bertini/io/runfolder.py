@@ -66,6 +66,12 @@ def summary_head(record: dict, cached: bool = False) -> str:
     seconds = f"{record['timings'].get('solve', 0.0):.2f} s"
     if cached:
         seconds = f"(cached: {seconds} when solved on {record.get('solved', '?')})"
+    if engine["flavour"] == "real":
+        return (
+            f"{c['distinct_solutions']} real solutions ({c['physical']} physical, "
+            f"{c['stable']} stable) by the real route: a branch and bound of {c['boxes']:,} boxes "
+            f"over the body angles; {seconds}"
+        )
     return (
         f"{c['distinct_solutions']} distinct finite solutions "
         f"({c['real']} real, {c['physical']} physical, {c['stable']} stable) from "

@@ -1,0 +1,289 @@
+"""Every critical point of V on a torus of angles, found and proved by one branch and bound over
+boxes of angles, many boxes at a time (interval arithmetic on numpy arrays, model.intervals).
+
+A `BoxLandscape` encloses grad V and its Hessian (a valid slope matrix where V is piecewise
+smooth) over a batch of boxes, and the squared lengths of the springs with free lengths, where V
+is not smooth at length 0. Each box is
+
+- set aside, where such a spring is shorter than `short` over the whole box, or may be and the
+  box is no wider than `min_width` (the statement bounds the spring length over these boxes);
+- excluded, where the enclosure of some component of grad V misses 0;
+- decided by the Krawczyk operator K(X) = m - Y g(m) + (I - Y H(X)) (X - m), Y the inverse of
+  the Hessian's midpoint: K(X) inside the interior of X proves exactly one critical point in X
+  (it lies in K(X)), K(X) disjoint from X proves none;
+- or split along its wide sides; a box that reaches the smallest width undecided is listed.
+
+A box with one critical point gives a root: Newton in double precision from the middle of
+K(X) n X, on the same enclosures taken at a point. Boxes are rows of two (B, n) arrays, lo and hi,
+in radians; the domain is [offset, offset + 2 pi]^n, with an offset that is no simple fraction
+of pi so that no symmetric pose falls on the edges of the first grid or of its halvings.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+
+from ..model.intervals import Interval
+from ..progress import Progress
+
+TWO_PI = 2 * math.pi
+OFFSET = -0.0123456789  # radians: the domain's lower corner (see the module docstring)
+BATCH = 4096  # boxes a step: large enough that numpy's loops, not Python, set the pace
+SHORT = 1e-3  # length units: springs shorter than this are set aside (V has a cone point at 0)
+MIN_WIDTH = 1e-4  # radians: the smallest box away from a critical point
+ROOT_FLOOR = 1e-10  # radians: boxes are not split below this, whatever a spring's length
+
+
+class BoxLandscape(Protocol):
+    """V over batches of boxes (see the module docstring)."""
+
+    n: int
+
+    def enclose(self, box: Interval) -> tuple[Interval, Interval, object]:
+        """Over each box: the squared lengths of the springs with free lengths (B, s), grad V
+        (B, n), and what `hessian` needs of the box (its cables' states)."""
+
+    def hessian(self, box: Interval, states: object) -> Interval:
+        """A slope matrix of grad V over each box (B, n, n)."""
+
+
+@dataclass
+class BoxSearch:
+    """What the search established: roots (one a box with exactly one critical point), boxes
+    set aside at cone points, boxes left undecided (at the smallest width, or at the budget)."""
+
+    roots: np.ndarray  # (R, n) angles in radians, in the domain
+    root_boxes: np.ndarray  # (R, 2n): lo and hi of the box each root was proved alone in
+    newton_failed: int  # 'one' boxes where Newton did not converge inside K(X) (kept: mid K)
+    set_aside: int
+    set_aside_bound: float  # every spring is at most this long somewhere in each box set aside
+    undecided: np.ndarray  # (U, 2n)
+    boxes: int
+    seconds: float
+    shortest_length: float  # every spring with a free length is at least this long elsewhere
+    budget_hit: str = ""
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def undecided_share(self) -> float:
+        """The share of the torus's volume in undecided boxes."""
+        if not len(self.undecided):
+            return 0.0
+        n = self.undecided.shape[1] // 2
+        w = self.undecided[:, n:] - self.undecided[:, :n]
+        return float(np.prod(w / TWO_PI, axis=1).sum())
+
+
+def initial_boxes(n: int, start: int) -> tuple[np.ndarray, np.ndarray]:
+    """A start x ... x start grid over the domain: (lo, hi), each (start^n, n)."""
+    edges = OFFSET + TWO_PI * np.arange(start + 1) / start
+    idx = np.indices((start,) * n).reshape(n, -1).T
+    return edges[idx], edges[idx + 1]
+
+
+def search(
+    land: BoxLandscape,
+    short: float,
+    min_width: float,
+    start: int = 8,
+    max_boxes: int | None = None,
+    max_seconds: float | None = None,
+    label: str = "real search",
+) -> BoxSearch:
+    """Decide every box of the torus (module docstring); stop at `max_boxes` or `max_seconds`
+    with the boxes not yet decided listed as undecided."""
+    t0 = time.perf_counter()
+    n = land.n
+    stack = [initial_boxes(n, start)]
+    roots, root_boxes, undecided = [], [], []
+    acc = {"boxes": 0, "aside": 0, "bound": 0.0, "shortest": math.inf, "failed": 0}
+    pending, budget = 1.0, ""
+    report = Progress(label, 1.0, "of the poses decided")
+    while stack:
+        lo, hi = _take(stack, BATCH)
+        share = float(np.prod((hi - lo) / TWO_PI, axis=1).sum())
+        if (max_boxes and acc["boxes"] >= max_boxes) or (
+            max_seconds and time.perf_counter() - t0 > max_seconds
+        ):
+            budget = f"stopped at {acc['boxes']:,} boxes after {time.perf_counter() - t0:.1f} s"
+            undecided.append(np.hstack([lo, hi]))
+            for a, b in stack:
+                undecided.append(np.hstack([a, b]))
+            break
+        acc["boxes"] += len(lo)
+        split, found, left = _step(land, lo, hi, short, min_width, acc)
+        roots += found[0]
+        root_boxes += found[1]
+        if len(left):
+            undecided.append(left)
+        if len(split[0]):
+            stack.append(split)
+            share -= float(np.prod((split[1] - split[0]) / TWO_PI, axis=1).sum())
+        pending -= share
+        report.set(1.0 - pending, note=f"{acc['boxes']:,} boxes")
+    report.close()
+    undec = np.vstack(undecided) if undecided else np.zeros((0, 2 * n))
+    return BoxSearch(
+        np.array(roots).reshape(-1, n), np.array(root_boxes).reshape(-1, 2 * n), acc["failed"],
+        acc["aside"], acc["bound"], undec, acc["boxes"], time.perf_counter() - t0,
+        acc["shortest"], budget,
+    )  # fmt: skip
+
+
+def _take(stack: list, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """Up to `count` boxes from the top of the stack (depth first keeps it short)."""
+    lo, hi = stack.pop()
+    if len(lo) > count:
+        stack.append((lo[:-count], hi[:-count]))
+        lo, hi = lo[-count:], hi[-count:]
+    return lo, hi
+
+
+def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, acc: dict):
+    """One batch: (boxes to split (lo, hi), (roots, their boxes), undecided (k, 2n))."""
+    box = Interval(lo, hi)
+    width = (hi - lo).max(axis=1)
+    dd, grad, states = land.enclose(box)
+    aside, smooth = np.zeros(len(lo), dtype=bool), np.ones(len(lo), dtype=bool)
+    floor = np.full(len(lo), float(min_width))
+    if dd.lo.shape[1]:
+        smooth = ~(dd.lo <= short * short).any(axis=1)
+        aside = (dd.hi < short * short).any(axis=1) | (~smooth & (width <= min_width))
+        if aside.any():
+            acc["aside"] += int(aside.sum())
+            longest = np.sqrt(np.maximum(dd.hi[aside].min(axis=1), 0.0)).max()
+            acc["bound"] = max(acc["bound"], float(longest))
+        floor = _floor(dd, min_width)
+    decided = np.zeros(len(lo), dtype=bool)
+    found: tuple[list, list] = ([], [])
+    test = np.flatnonzero(~aside & smooth)
+    if len(test):
+        zero = grad[test].contains_zero().all(axis=1)
+        decided[test[~zero]] = True
+        cand = test[zero]
+        if len(cand):
+            verdict, k_lo, k_hi = krawczyk(land, lo[cand], hi[cand], _subset(states, test[zero]))
+            decided[cand[verdict != 0]] = True
+            one = verdict == 1
+            if one.any():
+                found = _roots(land, lo[cand[one]], hi[cand[one]], k_lo[one], k_hi[one], acc)
+    leaf = ~aside & (decided | ~smooth)
+    if dd.lo.shape[1] and leaf.any():
+        low = np.sqrt(np.maximum(dd.lo[leaf].min(axis=1), 0.0)).min()
+        acc["shortest"] = min(acc["shortest"], float(low))
+    rest = ~aside & ~decided
+    small = rest & (width <= floor)
+    if small.any():  # a root in or next to the box: split on (Krawczyk wants small boxes there)
+        near = _root_near(land, lo[small], hi[small])
+        small[np.flatnonzero(small)[near & (width[small] > ROOT_FLOOR)]] = False
+    left = np.hstack([lo[small], hi[small]])
+    return _split(lo[rest & ~small], hi[rest & ~small]), found, left
+
+
+def _root_near(land: BoxLandscape, lo: np.ndarray, hi: np.ndarray, steps: int = 8) -> np.ndarray:
+    """Whether Newton from each box's middle ends within one box width of it (a critical point
+    there, badly conditioned or on an edge): such boxes are split further."""
+    x, w = 0.5 * (lo + hi), hi - lo
+    for _ in range(steps):
+        g, h = point_derivatives(land, x)
+        with np.errstate(all="ignore"):
+            ok = np.isfinite(h).all(axis=(1, 2)) & (np.abs(np.linalg.det(h)) > 1e-300)
+            dx = np.zeros_like(x)
+            if ok.any():
+                dx[ok] = np.linalg.solve(h[ok], g[ok][..., None])[..., 0]
+        x = x - np.where(ok[:, None], dx, 0.0)
+    return ((x >= lo - w) & (x <= hi + w)).all(axis=1) & np.isfinite(x).all(axis=1)
+
+
+def _subset(states, mask: np.ndarray):
+    """The landscape's per-box states kept for the boxes in `mask`."""
+    if isinstance(states, dict):
+        return {k: v[mask] for k, v in states.items()}
+    return states
+
+
+def _floor(dd: Interval, min_width: float) -> np.ndarray:
+    """The smallest width worth splitting to: `min_width`, or less where a spring is short (the
+    enclosures of its 1/d terms widen like width / d): a hundredth of d."""
+    shortest = np.sqrt(np.maximum(dd.lo.min(axis=1), 0.0))
+    return np.maximum(np.minimum(min_width, 0.01 * shortest), ROOT_FLOOR)
+
+
+def _split(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each box halved along every side at least half as wide as its widest."""
+    if not len(lo):
+        return lo, hi
+    w = hi - lo
+    cut = w >= 0.5 * w.max(axis=1, keepdims=True)
+    for j in range(lo.shape[1]):
+        c = cut[:, j]
+        mid = 0.5 * (lo[c, j] + hi[c, j])
+        upper_lo, upper_hi = lo[c].copy(), hi[c].copy()
+        upper_lo[:, j] = mid
+        hi = hi.copy()
+        hi[np.flatnonzero(c), j] = mid
+        lo, hi = np.vstack([lo, upper_lo]), np.vstack([hi, upper_hi])
+        cut = np.vstack([cut, cut[c]])
+    return lo, hi
+
+
+def krawczyk(land: BoxLandscape, lo: np.ndarray, hi: np.ndarray, states) -> tuple:
+    """(verdict, K lo, K hi) per box: 1 exactly one critical point (in K), -1 none, 0 unknown."""
+    n = lo.shape[1]
+    box = Interval(lo, hi)
+    mid = 0.5 * (lo + hi)
+    _, g_mid, _ = land.enclose(Interval(mid))
+    h = land.hessian(box, states)
+    h_mid = h.mid
+    ok = np.isfinite(h_mid).all(axis=(1, 2)) & g_mid.finite().all(axis=1)
+    ok &= np.abs(np.linalg.det(np.where(ok[:, None, None], h_mid, np.eye(n)))) > 1e-300
+    y = np.linalg.inv(np.where(ok[:, None, None], h_mid, np.eye(n)))
+    yg = (Interval(y) * Interval(g_mid.lo[:, None, :], g_mid.hi[:, None, :])).isum(axis=2)
+    yh = (Interval(y[:, :, :, None]) * Interval(h.lo[:, None, :, :], h.hi[:, None, :, :])).isum(
+        axis=2
+    )
+    spread = Interval(np.eye(n)) - yh  # (B, n, n)
+    dx = box - mid
+    tail = (spread * Interval(dx.lo[:, None, :], dx.hi[:, None, :])).isum(axis=2)
+    k = (Interval(mid) - yg) + tail
+    ok &= k.finite().all(axis=1)
+    inside = ok & ((k.lo > lo) & (k.hi < hi)).all(axis=1)
+    apart = ok & ((k.hi < lo) | (k.lo > hi)).any(axis=1)
+    verdict = np.where(inside, 1, np.where(apart, -1, 0))
+    return verdict, k.lo, k.hi
+
+
+def _roots(land: BoxLandscape, lo, hi, k_lo, k_hi, acc: dict, steps: int = 40):
+    """Newton from the middle of K n X to the critical point each box holds alone."""
+    a, b = np.maximum(lo, k_lo), np.minimum(hi, k_hi)
+    x = 0.5 * (a + b)
+    done = np.zeros(len(x), dtype=bool)
+    for _ in range(steps):
+        live = np.flatnonzero(~done)
+        if not len(live):
+            break
+        g, h = point_derivatives(land, x[live])
+        try:
+            dx = np.linalg.solve(h, g[..., None])[..., 0]
+        except np.linalg.LinAlgError:
+            break
+        new = x[live] - dx
+        inside = ((new >= a[live]) & (new <= b[live])).all(axis=1)
+        x[live] = np.where(inside[:, None], new, x[live])
+        small = np.abs(dx).max(axis=1) <= 1e-15 * (1 + np.abs(new).max(axis=1))
+        done[live[small | ~inside]] = True
+    good = ((x >= a) & (x <= b)).all(axis=1)
+    acc["failed"] += int((~good).sum())
+    return list(x), list(np.hstack([lo, hi]))
+
+
+def point_derivatives(land: BoxLandscape, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """grad V and its Hessian at points (R, n), from the enclosures at each point."""
+    point = Interval(x)
+    _, g, states = land.enclose(point)
+    return g.mid, land.hessian(point, states).mid

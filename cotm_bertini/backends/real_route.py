@@ -1,0 +1,209 @@
+"""The real route: a framework whose poses form a circle or torus solved on the reals, by the
+branch and bound of `boxes` over its body angles, with no complex generic set.
+
+V = sum k/2 (d - L0)^2 over springs + sum k/2 max(d - L0, 0)^2 over cables - the loads' work, so
+grad V = sum w r . dr/dangle + the loads' gradient, w = k (1 - L0/d) for a spring (k at zero free
+length) and k max(1 - L0/d, 0) for a cable. Both come from the derivation's generated
+`first_order` of the structure with every cable taut, evaluated on interval arrays (the source
+model.framework.ballcode runs on balls for the certificates); over a box where a cable may be at
+its free length, w is enclosed by the hull of 0 and k (1 - L0/d), and the Hessian by the hull of
+the generated Hessians of every taut set the box allows (grad V is Lipschitz and piecewise
+smooth, so that hull holds every slope: the Krawczyk test stays valid across a switch).
+
+Each critical point found becomes an endpoint of the polynomial system of the taut set its cables
+hold there (c, s of each body, and each link's length d and force density w), classified by
+analysis.framework_classify as the complex route's endpoints are.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+from ..model.framework.ballcode import ball_module
+from ..model.framework.compiled import FrameworkSystem, framework_system, slot_vector
+from ..model.framework.reach import cable_states
+from ..model.framework.spec import Framework
+from ..model.framework.structure import layout
+from ..model.framework.units import normalized_slots
+from ..model.intervals import Interval, stack
+from .endpoints import Endpoints
+
+TAUT, SLACK, EITHER = 1, 0, 2
+
+
+def covers(fw: Framework) -> str:
+    """'' where the real route covers the framework's configuration space, else why not."""
+    lay = layout(fw)
+    if fw.dim != 2:
+        return "a spatial framework (the real route covers circles and tori of planar bodies)"
+    if not lay.is_torus:
+        return "a closed loop, a free body or a free node (not a circle or torus of angles)"
+    return ""
+
+
+@dataclass(frozen=True, eq=False)
+class Link:
+    """A spring or cable as the landscape sees it (normalised units)."""
+
+    name: str
+    k: float
+    L0: float | None  # None: zero free length (w = k, smooth everywhere)
+    cable: bool
+
+
+class TorusFramework:
+    """V of a planar framework pinned in an open chain, over boxes of its body angles."""
+
+    def __init__(self, fw: Framework):
+        why = covers(fw)
+        if why:
+            raise ValueError(f"the real route does not cover {fw.name}: {why}")
+        self.fw = fw
+        slots = normalized_slots(fw)
+        self.P = [float(v) for v in slot_vector(slots)]
+        self.cables = tuple(c.name for c in fw.cables)
+        self.full = framework_system(fw, self.cables)
+        self.n = self.full.local_size
+        self.bodies = layout(fw).rotations
+        zfl = set(fw.zero_free_length())
+        self.links = tuple(
+            Link(x, slots[f"k_{x}"], None if x in zfl else slots[f"L0_{x}"], x in self.cables)
+            for x in self.full.active
+        )
+        self.free_springs = [i for i, x in enumerate(self.links) if x.L0 is not None
+                             and not x.cable]  # fmt: skip
+
+    @cached_property
+    def hessian_sets(self) -> list[tuple[tuple[str, ...], FrameworkSystem]]:
+        """Every taut set a pose may have (always-taut cables in all, never-taut in none)."""
+        states = cable_states(self.fw)
+        either = [c for c in self.cables if states[c] == "either"]
+        always = {c for c in self.cables if states[c] == "taut"}
+        out = []
+        for combo in itertools.product((True, False), repeat=len(either)):
+            on = always | {c for c, t in zip(either, combo, strict=True) if t}
+            taut = tuple(c for c in self.cables if c in on)
+            out.append((taut, framework_system(self.fw, taut)))
+        return out
+
+    def pose(self, fs: FrameworkSystem, box: Interval) -> list:
+        """The solver variables of `fs` over the boxes: c, s of each body (the rest 0: the
+        generated first_order and hessian of a torus read only the rotations)."""
+        index = {v: j for j, v in enumerate(fs.ps.variables)}
+        X: list = [0.0] * len(fs.ps.variables)
+        for j, b in enumerate(self.bodies):
+            angle = box[:, j]
+            X[index[f"s_{b}"]], X[index[f"c_{b}"]] = angle.sin(), angle.cos()
+        return X
+
+    def parts(self, box: Interval) -> tuple[list, list, list]:
+        """Per link its squared length and r . dr/dangle (n), and the loads' gradient."""
+        dim, m = self.fw.dim, self.n
+        first = ball_module(self.full).first_order(self.pose(self.full, box), self.P)
+        per, dds, slopes = dim + dim * m, [], []
+        for i in range(len(self.links)):
+            r, dr = first[i * per : i * per + dim], first[i * per + dim : (i + 1) * per]
+            dds.append(_sum(Interval.of(c) * c for c in r))
+            slopes.append([_sum(r[c] * dr[c * m + j] for c in range(dim)) for j in range(m)])
+        return dds, slopes, first[len(self.links) * per :]
+
+    def enclose(self, box: Interval) -> tuple[Interval, Interval, dict]:
+        """(squared lengths of the free-length springs, grad V, the cables' states) per box."""
+        dds, slopes, loads = self.parts(box)
+        shape = box.lo.shape[:1]
+        grad = [Interval.of(np.broadcast_to(0.0, shape)) + g for g in loads]
+        states = {}
+        for x, dd, a in zip(self.links, dds, slopes, strict=True):
+            w, state = self.force_density(x, dd)
+            if x.cable:
+                states[x.name] = state
+            grad = [g + w * aj for g, aj in zip(grad, a, strict=True)]
+        lengths = stack([dds[i] for i in self.free_springs], axis=1) if self.free_springs else (
+            Interval(np.zeros(shape + (0,))))  # fmt: skip
+        return lengths, stack(grad, axis=1), states
+
+    def force_density(self, x: Link, dd: Interval) -> tuple[Interval, np.ndarray]:
+        """w over each box, and a cable's state there (TAUT, SLACK or EITHER)."""
+        shape = dd.lo.shape
+        if x.L0 is None:
+            return Interval(np.full(shape, x.k)), np.full(shape, TAUT)
+        w = x.k * (1.0 - x.L0 / dd.sqrt())
+        if not x.cable:
+            return w, np.full(shape, TAUT)
+        l2 = x.L0 * x.L0
+        state = np.where(dd.lo > l2, TAUT, np.where(dd.hi < l2, SLACK, EITHER))
+        hull_lo = np.where(np.isfinite(w.lo), np.minimum(w.lo, 0.0), 0.0)
+        hull_hi = np.where(np.isfinite(w.hi), np.maximum(w.hi, 0.0), x.k)
+        lo = np.where(state == TAUT, w.lo, np.where(state == SLACK, 0.0, hull_lo))
+        hi = np.where(state == TAUT, w.hi, np.where(state == SLACK, 0.0, hull_hi))
+        return Interval(lo, hi), state
+
+    def hessian(self, box: Interval, states: dict) -> Interval:
+        """The hull of the Hessians of every taut set each box allows (B, n, n)."""
+        m, count = self.n, box.lo.shape[0]
+        lo, hi = np.full((count, m, m), np.inf), np.full((count, m, m), -np.inf)
+        for taut, fs in self.hessian_sets:
+            allowed = np.ones(count, dtype=bool)
+            for c in self.cables:
+                s = states.get(c, np.full(count, TAUT))
+                allowed &= (s == EITHER) | (s == (TAUT if c in taut else SLACK))
+            rows = np.flatnonzero(allowed)
+            if not len(rows):
+                continue
+            h = ball_module(fs).hessian(self.pose(fs, box[rows]), self.P)
+            h = stack([Interval.of(np.broadcast_to(0.0, (len(rows),))) + v for v in h], axis=1)
+            lo[rows] = np.minimum(lo[rows], h.lo.reshape(-1, m, m))
+            hi[rows] = np.maximum(hi[rows], h.hi.reshape(-1, m, m))
+        return Interval(lo, hi)
+
+    def endpoints(self, roots: np.ndarray) -> dict[tuple[str, ...], Endpoints]:
+        """The critical points (R, n angles) as endpoints of their taut sets' systems."""
+        point = Interval(roots)
+        dds, _, _ = self.parts(point)
+        d = {x.name: np.sqrt(np.maximum(dd.mid, 0.0)) for x, dd in zip(self.links, dds,
+                                                                       strict=True)}  # fmt: skip
+        taut = np.ones((len(roots), len(self.cables)), dtype=bool)
+        for j, c in enumerate(self.cables):
+            x = next((y for y in self.links if y.name == c), None)
+            if x is not None and x.L0 is not None:
+                taut[:, j] = d[c] >= x.L0
+        out = {}
+        for key in {tuple(row) for row in taut}:
+            rows = np.flatnonzero((taut == np.array(key)).all(axis=1))
+            names = tuple(c for c, on in zip(self.cables, key, strict=True) if on)
+            out[names] = self._endpoints(framework_system(self.fw, names), roots[rows], d, rows)
+        return out
+
+    def _endpoints(self, fs: FrameworkSystem, angles: np.ndarray, d: dict, rows) -> Endpoints:
+        links = {x.name: x for x in self.links}
+        values = np.zeros((len(rows), len(fs.ps.variables)), dtype=complex)
+        for k, v in enumerate(fs.ps.variables):
+            head, _, rest = v.partition("_")
+            if head in ("c", "s"):
+                a = angles[:, self.bodies.index(rest)]
+                values[:, k] = np.cos(a) if head == "c" else np.sin(a)
+            elif head == "d":
+                values[:, k] = d[rest][rows]
+            elif head == "w":
+                x = links[rest]
+                values[:, k] = x.k * (1.0 - x.L0 / d[rest][rows])
+            else:
+                raise ValueError(f"the real route has no value for unknown {v}")
+        count = len(rows)
+        nan = np.full(count, np.nan)
+        return Endpoints(
+            tuple(fs.ps.variables), values, np.asarray(rows, dtype=np.int64), nan, nan, nan,
+            np.zeros(count), nan, nan, nan, np.ones(count, dtype=np.int64),
+            np.zeros(count, dtype=bool),
+        )  # fmt: skip
+
+
+def _sum(items) -> Interval:
+    out = None
+    for v in items:
+        out = Interval.of(v) if out is None else out + v
+    return out

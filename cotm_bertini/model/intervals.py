@@ -1,0 +1,211 @@
+"""Interval arithmetic over numpy arrays: many boxes at once, rounded outwards.
+
+An `Interval` holds arrays `lo` and `hi` (any broadcastable shapes) with lo <= x <= hi for every
+real number x it stands for. Each operation computes its bounds in double precision and moves
+them outwards: IEEE addition, multiplication, division and square root are correctly rounded
+(error at most half an ulp), so one `nextafter` step each way keeps the true result inside;
+sin, cos and non-integer powers (whose libm results are not guaranteed correctly rounded) are
+widened further (`_PAD_TRIG`, `_PAD_POW`). An unbounded or undefined result is [-inf, inf].
+
+It has the methods a framework's generated code calls (+ - * / **, sqrt, sin, cos: the same
+source `model.framework.ballcode` evaluates on arb balls), so one call of a generated function
+encloses it over a whole batch of boxes: numpy's loops in place of one ball object per box.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+INF = np.inf
+_PAD_TRIG = 4e-16  # absolute: libm sin/cos are within one ulp (<= 1.2e-16 on [-1, 1])
+_PAD_POW = 8e-16  # relative: libm pow is within a few ulps
+
+
+def _down(x: np.ndarray) -> np.ndarray:
+    return np.nextafter(x, -INF)
+
+
+def _up(x: np.ndarray) -> np.ndarray:
+    return np.nextafter(x, INF)
+
+
+def _clean(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """NaN bounds (inf - inf, an undefined operation) become unbounded."""
+    return np.where(np.isnan(lo), -INF, lo), np.where(np.isnan(hi), INF, hi)
+
+
+class Interval:
+    """Arrays of closed intervals [lo, hi] (see the module docstring)."""
+
+    __slots__ = ("lo", "hi")
+    __array_priority__ = 1000  # numpy scalars and arrays defer to our reflected operators
+
+    def __init__(self, lo, hi=None):
+        self.lo = np.asarray(lo, dtype=float)
+        self.hi = self.lo if hi is None else np.asarray(hi, dtype=float)
+
+    # --- construction and queries -------------------------------------------------------------
+    @staticmethod
+    def of(x) -> Interval:
+        """An Interval from an Interval or an exact number (array)."""
+        return x if isinstance(x, Interval) else Interval(x)
+
+    @property
+    def mid(self) -> np.ndarray:
+        return 0.5 * self.lo + 0.5 * self.hi
+
+    @property
+    def width(self) -> np.ndarray:
+        return self.hi - self.lo
+
+    def contains_zero(self) -> np.ndarray:
+        return (self.lo <= 0.0) & (self.hi >= 0.0)
+
+    def finite(self) -> np.ndarray:
+        return np.isfinite(self.lo) & np.isfinite(self.hi)
+
+    def __getitem__(self, index) -> Interval:
+        return Interval(self.lo[index], self.hi[index])
+
+    def __repr__(self) -> str:
+        return f"Interval({self.lo!r}, {self.hi!r})"
+
+    @staticmethod
+    def hull(a: Interval, b: Interval) -> Interval:
+        return Interval(np.minimum(a.lo, b.lo), np.maximum(a.hi, b.hi))
+
+    @staticmethod
+    def where(mask, a: Interval, b: Interval) -> Interval:
+        a, b = Interval.of(a), Interval.of(b)
+        return Interval(np.where(mask, a.lo, b.lo), np.where(mask, a.hi, b.hi))
+
+    # --- arithmetic ---------------------------------------------------------------------------
+    def __neg__(self) -> Interval:
+        return Interval(-self.hi, -self.lo)
+
+    def __pos__(self) -> Interval:
+        return self
+
+    def __add__(self, other) -> Interval:
+        if not isinstance(other, Interval):
+            if np.ndim(other) == 0 and other == 0:
+                return self
+            other = Interval(other)
+        return Interval(*_clean(_down(self.lo + other.lo), _up(self.hi + other.hi)))
+
+    __radd__ = __add__
+
+    def __sub__(self, other) -> Interval:
+        return self + (-Interval.of(other))
+
+    def __rsub__(self, other) -> Interval:
+        return Interval.of(other) + (-self)
+
+    def square(self) -> Interval:
+        a, b = self.lo * self.lo, self.hi * self.hi
+        low = np.where(self.lo > 0, a, np.where(self.hi < 0, b, 0.0))
+        return Interval(*_clean(np.maximum(_down(low), 0.0), _up(np.maximum(a, b))))
+
+    def __mul__(self, other) -> Interval:
+        if other is self:
+            return self.square()
+        if not isinstance(other, Interval):
+            c = np.asarray(other, dtype=float)
+            if c.ndim == 0 and c == 1.0:
+                return self
+            lo = np.where(c >= 0, c * self.lo, c * self.hi)
+            hi = np.where(c >= 0, c * self.hi, c * self.lo)
+            return Interval(
+                *_clean(_down(np.where(c == 0, 0.0, lo)), _up(np.where(c == 0, 0.0, hi)))
+            )
+        p = [self.lo * other.lo, self.lo * other.hi, self.hi * other.lo, self.hi * other.hi]
+        # 0 * inf is nan; as a product of reals (an unbounded end stands for finite numbers) it
+        # is 0, and no input bound is nan (_clean), so 0 is the right value.
+        p = [np.where(np.isnan(v), 0.0, v) for v in p]
+        lo = np.minimum(np.minimum(p[0], p[1]), np.minimum(p[2], p[3]))
+        hi = np.maximum(np.maximum(p[0], p[1]), np.maximum(p[2], p[3]))
+        return Interval(_down(lo), _up(hi))
+
+    __rmul__ = __mul__
+
+    def reciprocal(self) -> Interval:
+        """1 / self; unbounded where self holds 0."""
+        zero = self.contains_zero()
+        with np.errstate(divide="ignore"):
+            lo, hi = _down(1.0 / self.hi), _up(1.0 / self.lo)
+        return Interval(np.where(zero, -INF, lo), np.where(zero, INF, hi))
+
+    def __truediv__(self, other) -> Interval:
+        if not isinstance(other, Interval):
+            c = np.asarray(other, dtype=float)
+            lo, hi = np.minimum(self.lo / c, self.hi / c), np.maximum(self.lo / c, self.hi / c)
+            return Interval(*_clean(_down(lo), _up(hi)))
+        return self * other.reciprocal()
+
+    def __rtruediv__(self, other) -> Interval:
+        return Interval.of(other) * self.reciprocal()
+
+    def __pow__(self, n) -> Interval:
+        if isinstance(n, (int, np.integer)) or (isinstance(n, float) and n.is_integer()):
+            n = int(n)
+            if n == 0:
+                return Interval(np.ones(np.broadcast(self.lo, self.hi).shape))
+            out, base, k = None, self, abs(n)
+            while k:  # repeated squaring: each step a valid enclosure
+                if k & 1:
+                    out = base if out is None else out * base
+                k >>= 1
+                base = base.square() if k else base
+            return out if n > 0 else out.reciprocal()
+        # A real power is defined for x >= 0 only (here: squared lengths).
+        lo, hi = np.maximum(self.lo, 0.0), np.maximum(self.hi, 0.0)
+        a, b = (lo**n, hi**n) if n > 0 else (hi**n, lo**n)
+        with np.errstate(invalid="ignore"):
+            return Interval(*_clean(a * (1 - _PAD_POW), b * (1 + _PAD_POW) + 1e-300))
+
+    # --- functions ----------------------------------------------------------------------------
+    def sqrt(self) -> Interval:
+        lo, hi = np.maximum(self.lo, 0.0), np.maximum(self.hi, 0.0)
+        return Interval(np.maximum(_down(np.sqrt(lo)), 0.0), _up(np.sqrt(hi)))
+
+    def cos(self) -> Interval:
+        return (self + np.pi / 2).sin()
+
+    def sin(self) -> Interval:
+        """sin over each interval: its values at the ends, and +-1 where a crest or trough of
+        sin lies inside (tested against pi rounded outwards, so none is missed)."""
+        lo, hi = self.lo, self.hi
+        a, b = np.sin(lo), np.sin(hi)
+        out_lo, out_hi = np.minimum(a, b) - _PAD_TRIG, np.maximum(a, b) + _PAD_TRIG
+        # crest at pi/2 + 2 pi k, trough at -pi/2 + 2 pi k: is one in [lo, hi]?
+        k_crest = np.ceil((lo - np.pi / 2) / (2 * np.pi) - 1e-12)
+        crest = np.pi / 2 + 2 * np.pi * k_crest <= hi * (1 + 1e-15) + 1e-12
+        k_trough = np.ceil((lo + np.pi / 2) / (2 * np.pi) - 1e-12)
+        trough = -np.pi / 2 + 2 * np.pi * k_trough <= hi * (1 + 1e-15) + 1e-12
+        wide = ~(hi - lo < 2 * np.pi) | ~np.isfinite(lo) | ~np.isfinite(hi)
+        out_hi = np.where(crest | wide, 1.0, np.minimum(out_hi, 1.0))
+        out_lo = np.where(trough | wide, -1.0, np.maximum(out_lo, -1.0))
+        return Interval(out_lo, out_hi)
+
+    def sin_cos(self) -> tuple[Interval, Interval]:
+        return self.sin(), self.cos()
+
+    def isum(self, axis: int) -> Interval:
+        """The sum along an axis, rounded outwards (a floating sum of n terms is within
+        (n - 1) eps sum |x_i| of the true one)."""
+        n = self.lo.shape[axis]
+        pad = n * np.finfo(float).eps
+        lo, hi = self.lo.sum(axis=axis), self.hi.sum(axis=axis)
+        with np.errstate(invalid="ignore"):
+            lo = lo - pad * np.abs(self.lo).sum(axis=axis) - 1e-300
+            hi = hi + pad * np.abs(self.hi).sum(axis=axis) + 1e-300
+        return Interval(*_clean(lo, hi))
+
+
+def stack(items: list, axis: int = -1) -> Interval:
+    """Intervals (or numbers) of one shape stacked along a new axis."""
+    items = [Interval.of(v) for v in items]
+    shape = np.broadcast_shapes(*(np.shape(v.lo) for v in items))
+    lo = np.stack([np.broadcast_to(v.lo, shape) for v in items], axis=axis)
+    hi = np.stack([np.broadcast_to(v.hi, shape) for v in items], axis=axis)
+    return Interval(lo, hi)

@@ -1,0 +1,240 @@
+"""The real route (issue 40): a framework on a circle or torus solved by the branch and bound
+over its body angles, checked against routes that share no code with it: an X-module's energy
+written here in plain numpy (Newton from a grid), the paper's built-in model solved by Bertini,
+the complex route, and interval arithmetic against 50-digit mpmath at sampled points."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import mpmath
+import numpy as np
+import pytest
+from conftest import ROOT
+
+import cotm_bertini as cb
+from cotm_bertini.model.intervals import Interval
+
+XMODULE = ROOT / "examples" / "xmodule.toml"
+MATCH_DEG = 1e-8
+
+
+# --- interval arithmetic ------------------------------------------------------------------------
+def _random_intervals(rng, n, scale=3.0, positive=False):
+    a, b = rng.normal(0, scale, n), rng.normal(0, scale, n)
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    if positive:
+        lo, hi = np.abs(lo) + 1e-3, np.abs(lo) + 1e-3 + np.abs(hi - lo)
+    # some degenerate and some tiny intervals, where rounding matters most
+    lo[:20], hi[:20] = lo[:20], lo[:20]
+    hi[20:40] = lo[20:40] + 1e-15
+    return lo, hi
+
+
+def _samples(lo, hi, rng):
+    t = np.concatenate([[0.0, 1.0], rng.uniform(0, 1, 3)])
+    return [np.clip(lo + s * (hi - lo), lo, hi) for s in t]  # a float sum may pass hi
+
+
+@pytest.mark.parametrize(
+    "name, op, exact, positive",
+    [
+        ("add", lambda a, b: a + b, lambda x, y: x + y, False),
+        ("sub", lambda a, b: a - b, lambda x, y: x - y, False),
+        ("mul", lambda a, b: a * b, lambda x, y: x * y, False),
+        ("div", lambda a, b: a / b, lambda x, y: x / y, True),
+        ("square", lambda a, b: a * a, lambda x, y: x * x, False),
+        ("cube", lambda a, b: a**3, lambda x, y: x**3, False),
+        ("sqrt", lambda a, b: b.sqrt(), lambda x, y: mpmath.sqrt(y), True),
+        ("pow1.5", lambda a, b: b ** (3 / 2), lambda x, y: y ** mpmath.mpf(1.5), True),
+        ("sin", lambda a, b: a.sin(), lambda x, y: mpmath.sin(x), False),
+        ("cos", lambda a, b: a.cos(), lambda x, y: mpmath.cos(x), False),
+        ("scalar", lambda a, b: 0.7 - 1.3 * a / 2.9, lambda x, y: 0.7 - 1.3 * x / 2.9, False),
+    ],
+)
+def test_intervals_enclose_every_sampled_value(name, op, exact, positive):
+    rng = np.random.default_rng(abs(hash(name)) % 2**32)
+    alo, ahi = _random_intervals(rng, 400)
+    blo, bhi = _random_intervals(rng, 400, positive=positive)
+    out = op(Interval(alo, ahi), Interval(blo, bhi))
+    mpmath.mp.dps = 50
+    for xs, ys in zip(_samples(alo, ahi, rng), _samples(blo, bhi, rng), strict=True):
+        for i in range(len(xs)):
+            v = exact(mpmath.mpf(float(xs[i])), mpmath.mpf(float(ys[i])))
+            assert mpmath.mpf(float(out.lo[i])) <= v <= mpmath.mpf(float(out.hi[i])), (name, i)
+    # Not wider than needed: the enclosure of a degenerate input is within 1e-14 of the value.
+    assert np.all(out.hi[:20] - out.lo[:20] <= 1e-13 * (1 + np.abs(out.lo[:20])))
+
+
+def test_sin_sees_the_crest_inside_an_interval():
+    box = Interval(np.array([1.0, 7.0, -2.0]), np.array([2.0, 8.0, -1.0]))  # pi/2, 5pi/2, -pi/2
+    s = box.sin()
+    assert s.hi[0] == 1.0 and s.hi[1] == 1.0 and s.lo[2] == -1.0
+
+
+# --- the X-module against an energy written here -------------------------------------------------
+# examples/xmodule.toml: bars from a = (0, 0) and b = (1, 0), length 1.3; spring between the tips
+# (k 1, L0s); cables bar1 tip - b and bar2 tip - a (k 2, L0c), tension only; load fy on bar1's tip.
+def _x_energy(t, L1=1.3, L0s=0.6, L0c=1.2, fy=-0.05):
+    """V and its exact gradient at angles t (N, 2)."""
+    t1, t2 = t[:, 0], t[:, 1]
+    p = np.stack([L1 * np.cos(t1), L1 * np.sin(t1)], axis=1)
+    q = np.stack([1.0 + 1.3 * np.cos(t2), 1.3 * np.sin(t2)], axis=1)
+    dp = np.stack([-L1 * np.sin(t1), L1 * np.cos(t1)], axis=1)
+    dq = np.stack([-1.3 * np.sin(t2), 1.3 * np.cos(t2)], axis=1)
+    zero = np.zeros_like(p)
+    links = [  # (vector, its derivative in t1, in t2, k, L0, cable)
+        (p - q, dp, -dq, 1.0, L0s, False),
+        (p - np.array([1.0, 0.0]), dp, zero, 2.0, L0c, True),
+        (q, zero, dq, 2.0, L0c, True),
+    ]
+    V, g = -fy * p[:, 1], np.stack([-fy * dp[:, 1], np.zeros(len(t))], axis=1)
+    for r, r1, r2, k, L0, cable in links:
+        d = np.linalg.norm(r, axis=1)
+        stretch = np.maximum(d - L0, 0.0) if cable else d - L0
+        V = V + 0.5 * k * stretch**2
+        w = k * stretch / d
+        g = g + w[:, None] * np.stack([(r * r1).sum(1), (r * r2).sum(1)], axis=1)
+    return V, g
+
+
+def _x_reference(**values):
+    """Every critical point: Newton (finite-difference Hessian of the exact gradient) from a
+    48 x 48 grid, ends with |grad| < 1e-11, one per point of the torus."""
+    grid = np.linspace(0, 2 * np.pi, 48, endpoint=False) + 0.013
+    t = np.array([(a, b) for a in grid for b in grid])
+    h = 1e-6
+
+    def hess(t):
+        cols = [(_x_energy(t + h * e, **values)[1] - _x_energy(t - h * e, **values)[1]) / (2 * h)
+                for e in np.eye(2)]  # fmt: skip
+        return np.stack(cols, axis=2)
+
+    for _ in range(60):
+        _, g = _x_energy(t, **values)
+        step = np.einsum("nij,nj->ni", np.linalg.pinv(hess(t)), g)
+        t = t - step * np.minimum(1.0, 0.3 / np.maximum(np.abs(step).max(1), 1e-300))[:, None]
+    _, g = _x_energy(t, **values)
+    found = []
+    for x in np.mod(t[np.abs(g).max(axis=1) < 1e-11], 2 * np.pi):
+        if all(np.abs((x - f + np.pi) % (2 * np.pi) - np.pi).max() > 1e-7 for f in found):
+            found.append(x)
+    theta = np.array(found)
+    return theta, _x_energy(theta, **values)[0], np.linalg.eigvalsh(hess(theta))
+
+
+def _pair(found_deg, ref_deg):
+    gap = np.abs((ref_deg[:, None, :] - found_deg[None] + 180.0) % 360.0 - 180.0).max(axis=2)
+    pick = gap.argmin(axis=1)
+    assert len(set(pick)) == len(pick) == len(found_deg), gap.min(axis=1)
+    return pick, gap.min(axis=1)
+
+
+@pytest.mark.parametrize("values", [{}, {"fy": -0.2, "L0c": 1.05}])
+def test_xmodule_real_route_equals_an_independent_newton_search(values):
+    theta, V, eig = _x_reference(**values)
+    fw = cb.Framework.from_toml(XMODULE).replace(**values)
+    res = cb.solve(fw, route="real", cache=False)
+    assert res.status == "ok", res.warnings
+    rows = res.physical
+    pick, gap = _pair(rows[["bar1.angle_deg", "bar2.angle_deg"]].to_numpy(float),
+                      np.degrees(theta))  # fmt: skip
+    assert gap.max() < MATCH_DEG
+    got = rows.iloc[pick]
+    np.testing.assert_allclose(got["energy"], V, atol=1e-10)
+    np.testing.assert_array_equal(got["index"].to_numpy(int), (eig < 0).sum(axis=1))
+    assert int(res.counts["stable"]) == int((eig > 0).all(axis=1).sum())
+    assert res.record["details"]["real_search"]["undecided"] == 0
+
+
+def test_xmodule_solve_on_the_command_line_takes_the_real_route(tmp_path):
+    out = subprocess.run(
+        [sys.executable, "-m", "cotm_bertini.cli", "solve", "--framework", str(XMODULE),
+         "--out", str(tmp_path), "--no-plots"],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert out.returncode == 0, out.stderr
+    assert "by the real route" in out.stdout
+    (run,) = {p.resolve() for p in tmp_path.glob("*/run.json")}  # the folder and 'latest'
+    record = json.loads(run.read_text())
+    assert record["engine"]["flavour"] == "real" and record["counts"]["physical"] == 12
+    assert record["details"]["real_search"]["boxes"] > 0
+
+
+# --- agreement with independent solvers ---------------------------------------------------------
+@pytest.mark.parametrize("case", ["case1", "case2", "case3"])
+def test_cotm_file_on_the_real_route_equals_the_papers_model(case):
+    """examples/cotm.toml by the real route against the built-in model solved by Bertini."""
+    p = cb.Params.case(case)
+    paper = cb.solve(p).physical
+    names = {"L01": p.L01, "L02": p.L02}
+    fw = cb.Framework.from_toml(ROOT / "examples" / "cotm.toml").replace(**names)
+    res = cb.solve(fw, route="real", cache=False)
+    assert res.status == "ok", res.warnings
+    got = res.physical
+    assert len(got) == len(paper)
+    ref = paper[["gamma1_deg", "gamma2_deg"]].to_numpy(float)
+    mine = got[["rod.angle_deg", "top.angle_deg"]].to_numpy(float)
+    pick, gap = _pair(mine, ref)
+    assert gap.max() < 1e-6
+    np.testing.assert_array_equal(got["stable"].to_numpy(bool)[pick],
+                                  paper["stable"].to_numpy(bool))  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    "name, values", [("zeeman", {"x": 0.1, "y": -0.25}), ("zeeman_cables", {"x": 1.45, "y": 0.2})]
+)
+def test_real_and_complex_routes_give_the_same_physical_rows(name, values):
+    fw = cb.Framework.from_toml(ROOT / "examples" / f"{name}.toml").replace(**values)
+    real, cplx = cb.solve(fw, route="real"), cb.solve(fw, route="complex")
+    assert real.status == cplx.status == "ok"
+    cols = ["wheel.angle_deg", "energy", "index"]
+    a, b = real.physical[cols].to_numpy(float), cplx.physical[cols].to_numpy(float)
+    assert a.shape == b.shape
+    np.testing.assert_allclose(a, b, atol=1e-8)
+
+
+# --- what the search cannot decide, and a sabotaged search -------------------------------------
+def test_a_search_stopped_early_is_incomplete_never_ok(tmp_path):
+    fw = cb.Framework.from_toml(XMODULE)
+    res = cb.solve(fw, route="real", timeout=1e-6, cache=False)
+    assert res.status == "incomplete"
+    assert any("undecided" in w for w in res.warnings)
+    out = subprocess.run(
+        [sys.executable, "-m", "cotm_bertini.cli", "solve", "--framework", str(XMODULE),
+         "--timeout", "1e-6", "--out", str(tmp_path), "--no-plots", "--no-cache"],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert out.returncode == 5, out.stdout + out.stderr
+
+
+def test_a_lost_root_is_caught_by_the_morse_count(monkeypatch):
+    """Sabotage: the search drops the first root it proves; the Morse count on the torus sees
+    the hole and the status says equilibria may be missing."""
+    from cotm_bertini.backends import boxes
+
+    real_roots = boxes._roots
+    dropped = []
+
+    def lossy(land, lo, hi, k_lo, k_hi, acc, steps=40):
+        roots, found = real_roots(land, lo, hi, k_lo, k_hi, acc, steps)
+        if roots and not dropped:
+            dropped.append(roots[0])
+            return roots[1:], found[1:]
+        return roots, found
+
+    monkeypatch.setattr(boxes, "_roots", lossy)
+    res = cb.solve(cb.Framework.from_toml(XMODULE), route="real", cache=False)
+    assert dropped and len(res.physical) == 11
+    assert res.status == "incomplete"
+    assert any("Morse" in w for w in res.warnings)
+
+
+def test_route_real_is_refused_where_it_does_not_cover_the_space():
+    fw = cb.Framework.from_toml(ROOT / "examples" / "fourbar.toml")
+    with pytest.raises(cb.ParameterError, match="route = 'real'.*closed loop"):
+        cb.solve(fw, route="real")
+    with pytest.raises(cb.ParameterError, match="route = 'bogus'"):
+        cb.Settings(route="bogus")

@@ -33,7 +33,8 @@ from ..progress import Progress
 
 TWO_PI = 2 * math.pi
 OFFSET = -0.0123456789  # radians: the domain's lower corner (see the module docstring)
-BATCH = 4096  # boxes a step: large enough that numpy's loops, not Python, set the pace
+BATCH = 4096
+KRAWCZYK_WIDTH = 0.2  # radians: wider boxes are split, not tested (the test rarely decides them)  # boxes a step: large enough that numpy's loops, not Python, set the pace
 SHORT = 1e-3  # length units: springs shorter than this are set aside (V has a cone point at 0)
 MIN_WIDTH = 1e-4  # radians: the smallest box away from a critical point
 ROOT_FLOOR = 1e-10  # radians: boxes are not split below this, whatever a spring's length
@@ -165,7 +166,7 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, acc: dict)
     if len(test):
         zero = grad[test].contains_zero().all(axis=1)
         decided[test[~zero]] = True
-        cand = test[zero]
+        cand = test[zero & (width[test] <= KRAWCZYK_WIDTH)]
         if len(cand):
             verdict, k_lo, k_hi = krawczyk(land, lo[cand], hi[cand], _subset(states, test[zero]))
             decided[cand[verdict != 0]] = True

@@ -90,20 +90,23 @@ class TorusFramework:
             out.append((taut, framework_system(self.fw, taut)))
         return out
 
-    def pose(self, fs: FrameworkSystem, box: Interval) -> list:
-        """The solver variables of `fs` over the boxes: c, s of each body (the rest 0: the
-        generated first_order and hessian of a torus read only the rotations)."""
+    def pose(self, fs: FrameworkSystem, trig: list) -> list:
+        """The solver variables of `fs` over the boxes from each body's (sin, cos) (`trig`; the
+        rest 0: the generated first_order and hessian of a torus read only the rotations)."""
         index = {v: j for j, v in enumerate(fs.ps.variables)}
         X: list = [0.0] * len(fs.ps.variables)
-        for j, b in enumerate(self.bodies):
-            angle = box[:, j]
-            X[index[f"s_{b}"]], X[index[f"c_{b}"]] = angle.sin(), angle.cos()
+        for b, (s, c) in zip(self.bodies, trig, strict=True):
+            X[index[f"s_{b}"]], X[index[f"c_{b}"]] = s, c
         return X
+
+    def trig(self, box: Interval) -> list:
+        """(sin, cos) of each body's angle over the boxes."""
+        return [box[:, j].sin_cos() for j in range(len(self.bodies))]
 
     def parts(self, box: Interval) -> tuple[list, list, list]:
         """Per link its squared length and r . dr/dangle (n), and the loads' gradient."""
         dim, m = self.fw.dim, self.n
-        first = ball_module(self.full).first_order(self.pose(self.full, box), self.P)
+        first = ball_module(self.full).first_order(self.pose(self.full, self.trig(box)), self.P)
         per, dds, slopes = dim + dim * m, [], []
         for i in range(len(self.links)):
             r, dr = first[i * per : i * per + dim], first[i * per + dim : (i + 1) * per]
@@ -145,6 +148,7 @@ class TorusFramework:
     def hessian(self, box: Interval, states: dict) -> Interval:
         """The hull of the Hessians of every taut set each box allows (B, n, n)."""
         m, count = self.n, box.lo.shape[0]
+        trig = self.trig(box)
         lo, hi = np.full((count, m, m), np.inf), np.full((count, m, m), -np.inf)
         for taut, fs in self.hessian_sets:
             allowed = np.ones(count, dtype=bool)
@@ -154,7 +158,8 @@ class TorusFramework:
             rows = np.flatnonzero(allowed)
             if not len(rows):
                 continue
-            h = ball_module(fs).hessian(self.pose(fs, box[rows]), self.P)
+            sub = [(s[rows], c[rows]) for s, c in trig] if len(rows) < count else trig
+            h = ball_module(fs).hessian(self.pose(fs, sub), self.P)
             h = stack([Interval.of(np.broadcast_to(0.0, (len(rows),))) + v for v in h], axis=1)
             lo[rows] = np.minimum(lo[rows], h.lo.reshape(-1, m, m))
             hi[rows] = np.maximum(hi[rows], h.hi.reshape(-1, m, m))

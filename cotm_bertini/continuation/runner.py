@@ -206,7 +206,11 @@ def warm_generic_sets(spec: SweepSpec, scheduler: str | None = None) -> None:
     if scheduler:
         settings = settings.replace(scheduler=scheduler)
     if spec.framework is not None:
+        from ..point import framework_route
         from .framework import warm_generic_sets as framework_sets
+
+        if framework_route(spec.params_at(0), settings) == "real":
+            return  # the real route solves no generic set
 
         framework_sets(spec.params_at, sorted({0, spec.size() - 1}), settings)
         return

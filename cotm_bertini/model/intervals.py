@@ -30,8 +30,15 @@ def _up(x: np.ndarray) -> np.ndarray:
 
 
 def _clean(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """NaN bounds (inf - inf, an undefined operation) become unbounded."""
-    return np.where(np.isnan(lo), -INF, lo), np.where(np.isnan(hi), INF, hi)
+    """NaN bounds (inf - inf, an undefined operation) become unbounded: no bound is ever NaN,
+    which the products rely on."""
+    bad = np.isnan(lo)
+    if bad.any():
+        lo = np.where(bad, -INF, lo)
+    bad = np.isnan(hi)
+    if bad.any():
+        hi = np.where(bad, INF, hi)
+    return lo, hi
 
 
 class Interval:
@@ -121,7 +128,7 @@ class Interval:
         p = [self.lo * other.lo, self.lo * other.hi, self.hi * other.lo, self.hi * other.hi]
         # 0 * inf is nan; as a product of reals (an unbounded end stands for finite numbers) it
         # is 0, and no input bound is nan (_clean), so 0 is the right value.
-        p = [np.where(np.isnan(v), 0.0, v) for v in p]
+        p = [np.where(np.isnan(v), 0.0, v) if np.isnan(v).any() else v for v in p]
         lo = np.minimum(np.minimum(p[0], p[1]), np.minimum(p[2], p[3]))
         hi = np.maximum(np.maximum(p[0], p[1]), np.maximum(p[2], p[3]))
         return Interval(_down(lo), _up(hi))

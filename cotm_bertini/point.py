@@ -60,7 +60,7 @@ class PointSolution:
     input_text: str
     timings: dict
     warm: object = None  # homotopy engine: this point as a start for a neighbouring one
-    continua: tuple = ()  # a framework's continua of equilibria (analysis.framework_continua)
+    continua: tuple = ()  # a framework's continua of equilibria: continuum_record dicts
 
     @cached_property
     def table(self):
@@ -204,7 +204,7 @@ def solve_framework_point(
     `warm` of a neighbouring point's solution: a start per taut set) lets a sweep continue each
     taut set from that point by Newton (backends.target.solve_parameters)."""
     from .analysis.framework_checks import completeness, framework_counts, order_rows
-    from .analysis.framework_continua import absorb, find_continua
+    from .analysis.framework_continua import absorb, continuum_record, find_continua
     from .model.framework.compiled import framework_system
     from .model.framework.structure import check_mobility
     from .model.framework.units import normalized_slots, units
@@ -247,7 +247,7 @@ def solve_framework_point(
     return PointSolution(
         fw, settings, table, None, counts, checks["morse"], status, tuple(checks["warnings"]),
         engine, shape, {"taut_sets": report}, "\n".join(texts), t.stages, starts,
-        tuple(continua),
+        tuple(continuum_record(c, n) for n, c in enumerate(continua, start=1)),
     )  # fmt: skip
 
 

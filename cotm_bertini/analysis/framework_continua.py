@@ -266,3 +266,62 @@ def _index_across(fw, fs, points, tol) -> int | None:
             return None
         found.add(int((eig < -limit).sum()))
     return found.pop() if len(found) == 1 else None
+
+
+def continuum_record(c: Continuum, n: int) -> dict:
+    """What run.json, continua.csv and the console say of continuum n (docs/frameworks.md)."""
+    term, why = c.morse()
+    shape = "closed curve" if c.closed else "arc" if c.dimension == 1 else "not traced"
+    kind = {0: "neutral minima", None: "degenerate across the curve"}.get(
+        c.index, f"neutral saddles (index {c.index} across)"
+    )
+    pose = [n for n in c.columns if n.endswith(".angle_deg")]
+    ends = [] if c.closed else [
+        {"by": by, **{p: float(c.columns[p][k]) for p in pose}}
+        for by, k in zip(c.ends, (0, -1), strict=True)
+    ]  # fmt: skip
+    return {"continuum": n, "taut_set": " ".join(c.taut) or "none", "dimension": c.dimension,
+            "shape": shape, "kind": kind, "index_across": c.index,
+            "energy": float(np.mean(c.energy)),
+            "energy_spread": float(np.ptp(c.energy)), "extent": _extent(c), "ends": ends,
+            "points": len(c.points), "morse_term": term, "morse_note": why}  # fmt: skip
+
+
+def _extent(c: Continuum) -> dict[str, list[float]]:
+    """Each body angle's range along the curve (degrees, from its lower end; the interior
+    extremes refined on the curve by golden section), [0, 360] where it winds around."""
+    out = {}
+    for body in [n[:-10] for n in c.columns if n.endswith(".angle_deg")]:
+        k = (c.fs.ps.variables.index(f"c_{body}"), c.fs.ps.variables.index(f"s_{body}"))
+        turn = np.unwrap(np.arctan2(c.points[:, k[1]], c.points[:, k[0]]))
+        if np.ptp(turn) >= 2 * np.pi - 1e-6:
+            out[f"{body}.angle_deg"] = [0.0, 360.0]
+            continue
+        lo = _refined(c, k, turn, int(np.argmin(turn)), -1.0)
+        hi = _refined(c, k, turn, int(np.argmax(turn)), 1.0)
+        start = np.degrees(lo) % 360.0
+        out[f"{body}.angle_deg"] = [float(start), float(start + np.degrees(hi - lo))]
+    return out
+
+
+def _refined(c: Continuum, k, turn, i: int, sign: float) -> float:
+    """The extreme of an angle near traced point i (unwrapped like `turn`): the point itself at
+    an end of an arc, else the extreme over the curve within a step of it."""
+    if not c.closed and i in (0, len(c.points) - 1):
+        return float(turn[i])
+    x = c.points[i]
+    t = _null(c.system, c.scale, x)[0]
+
+    def angle(s: float) -> float:
+        y = _correct(c.system, c.scale, x + s * t, t, x + s * t)[0]
+        a = np.arctan2(y[k[1]], y[k[0]])
+        return float(turn[i] + (a - turn[i] + np.pi) % (2 * np.pi) - np.pi)
+
+    a, b, g = -STEP_MAX, STEP_MAX, (np.sqrt(5) - 1) / 2
+    for _ in range(60):
+        m1, m2 = b - g * (b - a), a + g * (b - a)
+        if sign * angle(m1) > sign * angle(m2):
+            b = m2
+        else:
+            a = m1
+    return sign * max(sign * angle((a + b) / 2), sign * turn[i])

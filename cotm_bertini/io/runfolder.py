@@ -168,6 +168,7 @@ def write_solution_files(folder: Path, point: PointSolution) -> None:
         atomic_write_text(folder / CONTINUA_CSV, columns_csv(continua_columns(point.continua)))
     paper = "gamma1_deg" in point.columns
     tables = ("solutions", "counts") if paper else ("framework", "framework_counts")
+    tables += ("framework_continua",) * bool(point.continua)
     atomic_write_text(folder / COLUMNS_MD, reference(*tables))
     if not (folder / "input").exists():
         atomic_write_text(folder / "input", point.input_text)

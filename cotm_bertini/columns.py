@@ -240,7 +240,8 @@ FRAMEWORK = {
     "reason": "why a row is not physical: complex, negative_length:NAME, cable_pushes:NAME (a "
     "taut cable shorter than L0), slack_cable_stretched:NAME (a slack one longer), "
     "switch_duplicate:NAME (an equilibrium with cable NAME at its free length, found by both "
-    "taut sets: this is the second row of it); empty if physical",
+    "taut sets: this is the second row of it), continuum:N (a point of continuum N of "
+    "continua.csv, counted there, not as an isolated equilibrium); empty if physical",
     "hess_min_eig": "the smallest reduced-Hessian eigenvalue (the framework's units)",
     "max_imag": "the largest |Im| / (1 + |Re|) over the unknowns",
     "residual": "max |f_i| of the polynomial system at the refined point (framework's units)",
@@ -264,6 +265,27 @@ FRAMEWORK_COUNTS = {
     "taut_sets_pruned": "taut sets no pose can hold, not solved (bound smoothing; the proof "
     "in details.taut_sets)",
     "closed_form_endpoints": "0: a framework has no closed-form roots",
+    "continua": "continua of equilibria (continua.csv; run.json `continua`), not in the counts "
+    "above",
+}
+
+FRAMEWORK_CONTINUA = {
+    "continuum": "its number N (rows on it in solutions.csv have reason continuum:N)",
+    "taut_set": "the cables taut along it",
+    "dimension": "1: a curve, traced; 2 or more: found (the Jacobian's null space), not traced",
+    "shape": "arc (two ends), closed curve, or not traced",
+    "kind": "neutral minima (V constant along it, rising across: index 0 across), neutral "
+    "saddles (index k across), or degenerate across the curve somewhere",
+    "index_across": "the number of negative reduced-Hessian eigenvalues across the curve",
+    "energy, energy_spread": "V's mean and range over its traced points (user units)",
+    "BODY.angle_deg.min, .max": "the body angle's range along it (interior extremes refined on "
+    "the curve; 0 and 360 where it winds around)",
+    "end1_by, end2_by": "what ends an arc: a slack cable reaching its free length (turns taut), "
+    "a taut one reaching it (turns slack), a spring's zero length, or a singular point",
+    "end1.BODY.angle_deg, end2...": "the pose of each end",
+    "points": "points traced along it",
+    "morse_term, morse_note": "its term in the Morse sum (an arc of minima ended by cables "
+    "turning taut: 1; a closed curve: 0; docs/frameworks.md), or empty and why none is known",
 }
 
 
@@ -374,8 +396,8 @@ def markdown(title: str, columns: dict[str, str], head: str = "column") -> str:
 def reference(*tables: str, title: str = "Columns of the CSV files in this folder") -> str:
     """The column reference of a run folder: 'solutions', 'counts', 'sweep', 'events',
     'barriers', 'folds', 'regions', 'design', 'framework', 'framework_counts',
-    'framework_sweep', 'framework_events', 'framework_folds', 'framework_regions',
-    'framework_barriers', 'move', 'framework_move', 'snaps', 'plan'."""
+    'framework_continua', 'framework_sweep', 'framework_events', 'framework_folds',
+    'framework_regions', 'framework_barriers', 'move', 'framework_move', 'snaps', 'plan'."""
     known = {
         "solutions": ("solutions.csv", SOLUTIONS),
         "counts": ("counts (run.json `counts`, `res.counts`)", COUNTS, "count"),
@@ -392,6 +414,7 @@ def reference(*tables: str, title: str = "Columns of the CSV files in this folde
         "design": ("the design CSV (`cotm-bertini design --out`)", DESIGN),
         "framework": ("solutions.csv of a framework (`--framework`)", FRAMEWORK),
         "framework_counts": ("counts of a framework solve", FRAMEWORK_COUNTS, "count"),
+        "framework_continua": ("continua.csv of a framework", FRAMEWORK_CONTINUA),
         "framework_sweep": ("sweep.csv of a framework", FRAMEWORK_SWEEP),
         "framework_events": ("events.csv of a framework", FRAMEWORK_EVENTS),
         "framework_folds": ("folds.csv of a framework's map", FRAMEWORK_FOLDS),
@@ -415,6 +438,7 @@ def document() -> str:
         "design",
         "framework",
         "framework_counts",
+        "framework_continua",
         "framework_sweep",
         "framework_events",
         "framework_folds",

@@ -60,6 +60,7 @@ class PointSolution:
     input_text: str
     timings: dict
     warm: object = None  # homotopy engine: this point as a start for a neighbouring one
+    continua: tuple = ()  # a framework's continua of equilibria: continuum_record dicts
 
     @cached_property
     def table(self):
@@ -203,6 +204,7 @@ def solve_framework_point(
     `warm` of a neighbouring point's solution: a start per taut set) lets a sweep continue each
     taut set from that point by Newton (backends.target.solve_parameters)."""
     from .analysis.framework_checks import completeness, framework_counts, order_rows
+    from .analysis.framework_continua import absorb, continuum_record, find_continua
     from .model.framework.compiled import framework_system
     from .model.framework.structure import check_mobility
     from .model.framework.units import normalized_slots, units
@@ -234,9 +236,12 @@ def solve_framework_point(
             parts.append(part)
             texts.append(text)
     with t.stage("classify"):
-        table = order_rows(fw, parts)
-        checks = completeness(fw, table, report)
-    counts = framework_counts(table, report)
+        # Rows on a curve of equilibria are that curve's points, counted apart (issue 39).
+        continua = find_continua(fw, parts, unit, tolerances)
+        absorb(parts, continua)
+        table = order_rows(fw, [p[0] for p in parts])
+        checks = completeness(fw, table, report, continua)
+    counts = framework_counts(table, report, continua)
     status = STATUS_INCOMPLETE if checks["warnings"] else STATUS_OK
     engine = {"flavour": "homotopy", "path": "bertini module (in-process)",
               "version": _bertini_version()}  # fmt: skip
@@ -244,6 +249,7 @@ def solve_framework_point(
     return PointSolution(
         fw, settings, table, None, counts, checks["morse"], status, tuple(checks["warnings"]),
         engine, shape, {"taut_sets": report}, "\n".join(texts), t.stages, starts,
+        tuple(continuum_record(c, n) for n, c in enumerate(continua, start=1)),
     )  # fmt: skip
 
 
@@ -372,10 +378,11 @@ def _cable_subsets(fw) -> list[tuple[str, ...]]:
 
 
 def _solve_taut_set(fw, taut, unit, target, centre, settings, tolerances, t: Timings, warm):
-    """One taut set: (its rows or None, what was done, the homotopy input text). `warm`: (the
-    starts of a neighbouring point by system key, where this point's starts go)."""
+    """One taut set: ((its rows, its system, their solutions) or None, what was done, the
+    homotopy input text). `warm`: (the starts of a neighbouring point by system key, where this
+    point's starts go)."""
     from .analysis.framework_checks import continuum_check
-    from .analysis.framework_classify import framework_columns
+    from .analysis.framework_classify import framework_rows
     from .backends.target import solve_parameters
     from .model.framework.compiled import framework_system, variable_groups
 
@@ -392,9 +399,9 @@ def _solve_taut_set(fw, taut, unit, target, centre, settings, tolerances, t: Tim
     if hs.warm is not None:
         warm[1][fs.key] = hs.warm
     with t.stage("classify"):
-        part = framework_columns(fw, fs, hs.endpoints, unit, tolerances)
+        cols, x = framework_rows(fw, fs, hs.endpoints, unit, tolerances)
     info = {**hs.info, "variables": list(fs.ps.variables), "functions": len(fs.ps.names)}
-    return part, info, hs.input_text
+    return (cols, fs, x), info, hs.input_text
 
 
 def _bertini_version() -> str:

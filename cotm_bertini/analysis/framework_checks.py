@@ -62,8 +62,8 @@ def _merge_switch_pairs(fw: Framework, cols: dict) -> None:
             cols["reason"][gone] = f"switch_duplicate:{cable}"
 
 
-def framework_counts(table: dict, report: dict) -> dict:
-    """Paths tracked, endpoints and solution counts over every taut set."""
+def framework_counts(table: dict, report: dict, continua: list = ()) -> dict:
+    """Paths tracked, endpoints and solution counts over every taut set (continua apart)."""
     solved = [r for r in report.values() if "tracked" in r]
     return {
         "paths_tracked": sum(r["tracked"] for r in solved),
@@ -82,11 +82,13 @@ def framework_counts(table: dict, report: dict) -> dict:
             "tracked" not in r and "pruned" not in r and "route" not in r for r in report.values()
         ),
         "taut_sets_pruned": sum("pruned" in r for r in report.values()),
+        "continua": len(continua),
     }
 
 
-def completeness(fw: Framework, table: dict, report: dict) -> dict:
-    """Why no equilibrium is missing, or warnings saying why one may be: {"morse", "warnings"}."""
+def completeness(fw: Framework, table: dict, report: dict, continua: list = ()) -> dict:
+    """Why no equilibrium is missing, or warnings saying why one may be: {"morse", "warnings"}
+    (`continua`: analysis.framework_continua's, each a term of the Morse sum)."""
     warnings = []
     for label, info in report.items():
         if info.get("route") == "real":  # the search's own record says what it left
@@ -109,14 +111,18 @@ def completeness(fw: Framework, table: dict, report: dict) -> dict:
                 f"taut set {label}: {info['generic_singular']} singular endpoints at generic "
                 "parameters (a positive-dimensional solution set, not enumerated)"
             )
-    morse = morse_count(fw, table)
+    morse = morse_count(fw, table, continua)
+    if morse.get("continuum_unknown"):
+        warnings.append(f"{morse['reason']}: the Morse check is not applicable, so equilibria "
+                        "may be missing")  # fmt: skip
     if morse["applicable"] and not morse["ok"]:
         total, chi, space = morse["euler_characteristic"], morse["expected"], morse["manifold"]
         parts = [f"Morse count {total} != {chi}, the Euler characteristic of {space}"] * (
             total != chi
         )
         parts += [f"{morse['degenerate']} degenerate"] * bool(morse["degenerate"])
-        parts += [f"no minimum, though V has one on the compact {space}"] * (not morse["min"])
+        none = not (morse["min"] or morse["continua_minima"])
+        parts += [f"no minimum, though V has one on the compact {space}"] * none
         warnings.append("; ".join(parts) + ": equilibria may be missing")
     return {"morse": morse, "warnings": warnings}
 
@@ -150,12 +156,18 @@ def _collapsible(fw: Framework) -> list[str]:
             if slots[f"L0_{x.name}"] > 0 and length_bounds(fw, x.a, x.b)[0] <= 0]  # fmt: skip
 
 
-def morse_count(fw: Framework, table: dict) -> dict:
-    """sum (-1)^index over the physical equilibria (plus the cone maxima) must equal the Euler
-    characteristic of the configuration space: 0 for a torus, 2^n for n spheres S2."""
+def morse_count(fw: Framework, table: dict, continua: list = ()) -> dict:
+    """sum (-1)^index over the physical equilibria (plus the cone maxima, plus each continuum's
+    term: docs/frameworks.md) must equal the Euler characteristic of the configuration space: 0
+    for a torus, 2^n for n spheres S2."""
     factors, why = configuration_space(fw)
     if not factors:
         return {"applicable": False, "ok": None, "reason": why or "nothing moves"}
+    terms = [c.morse() for c in continua]
+    for n, (term, why) in enumerate(terms, start=1):
+        if term is None:
+            why = f"continuum {n} ({why}) has no known term in the Morse sum"
+            return {"applicable": False, "ok": None, "continuum_unknown": True, "reason": why}
     torus2 = factors == ["S1", "S1"] and fw.dim == 2
     collapsible = _collapsible(fw)
     if collapsible and not torus2:
@@ -168,13 +180,16 @@ def morse_count(fw: Framework, table: dict) -> dict:
     counts = {k: int((kinds == k).sum()) for k in ("min", "saddle", "max", "degenerate")}
     maxima = sum(c["is_max"] for c in cone_points(fw)) if torus2 else 0
     total = int(sum((-1) ** int(i) for i, k in zip(index, kinds, strict=True) if k != "degenerate"))
-    total += maxima * (-1) ** len(factors)
+    total += maxima * (-1) ** len(factors) + sum(t for t, _ in terms)
     # V is continuous on the compact configuration space: its global minimum is an equilibrium
-    # (a cone point is a maximum), so a table without a minimum misses equilibria, whatever the
-    # alternating sum says (an empty table sums to the torus' 0).
-    ok = total == chi and counts["degenerate"] == 0 and counts["min"] > 0
+    # (a cone point is a maximum), so a table without a minimum (isolated or a continuum of
+    # minima) misses equilibria, whatever the alternating sum says (an empty table sums to 0).
+    minima = sum(c.index == 0 for c in continua)
+    ok = total == chi and counts["degenerate"] == 0 and counts["min"] + minima > 0
     return {"applicable": True, "manifold": " x ".join(factors), "expected": chi, **counts,
-            "zero_length_maxima": maxima, "euler_characteristic": total, "ok": ok}  # fmt: skip
+            "zero_length_maxima": maxima, "continua": len(continua), "continua_minima": minima,
+            "continua_term": sum(t for t, _ in terms), "euler_characteristic": total,
+            "ok": ok}  # fmt: skip
 
 
 def cone_points(fw: Framework) -> list[dict]:

@@ -23,6 +23,11 @@ def framework_columns(
     tol: Tolerances = Tolerances(),
 ) -> dict[str, np.ndarray]:
     """One row per distinct solution of one taut set (endpoints in normalised units)."""
+    return framework_rows(fw, fs, endpoints, unit, tol)[0]
+
+
+def framework_rows(fw, fs, endpoints: Endpoints, unit, tol: Tolerances = Tolerances()) -> tuple:
+    """framework_columns and the refined solutions behind its rows (normalised units)."""
     slots_n = normalized_slots(fw)
     system = fs.ps.instantiate([slots_n[n] for n in fs.ps.parameters])
     merged = merge_endpoints(system, endpoints.points, endpoints, tol, scaled=True)
@@ -30,14 +35,7 @@ def framework_columns(
     max_imag = (np.abs(x.imag) / (1.0 + np.abs(x.real))).max(axis=1) if len(x) else np.zeros(0)
     loose = np.minimum(10.0 * np.sqrt(np.maximum(merged.accuracy, 1e-16)), 1e-4)
     is_real = max_imag < np.where(merged.singular, np.maximum(loose, tol.imag), tol.imag)
-    X = x * variable_scale(fs, unit)
-    var = {name: X[:, k] for k, name in enumerate(fs.ps.variables)}
-    pos = positions(fs, x, slot_vector(slots_n), fw.dim, unit[0])
-    cols: dict[str, np.ndarray] = {}
-    cols.update(pose_columns(fw, fs, var, pos))
-    links, reason, borderline = _link_columns(fw, fs, var, pos, unit, tol)
-    cols.update(links)
-    cols["energy"] = _energy(fw, pos, links)
+    cols, reason, borderline = described(fw, fs, x, unit, tol)
     reason = np.where(is_real, reason, "complex").astype(object)
     physical = is_real & (reason == "")
     kind, index, eig = _stability(fs, x, slots_n, physical & ~merged.singular, tol)
@@ -51,7 +49,21 @@ def framework_columns(
         taut_set=np.array([" ".join(fs.taut)] * len(x), dtype=object),
         paths=np.array(merged.paths, dtype=object),
     )  # fmt: skip
-    return cols
+    return cols, x
+
+
+def described(fw: Framework, fs: FrameworkSystem, x: np.ndarray, unit, tol) -> tuple:
+    """The pose, link and energy columns of solutions `x` (normalised units), the first reason
+    each is not an equilibrium of the real mechanism, and which have a cable at its free length."""
+    X = x * variable_scale(fs, unit)
+    var = {name: X[:, k] for k, name in enumerate(fs.ps.variables)}
+    pos = positions(fs, x, slot_vector(normalized_slots(fw)), fw.dim, unit[0])
+    cols: dict[str, np.ndarray] = {}
+    cols.update(pose_columns(fw, fs, var, pos))
+    links, reason, borderline = _link_columns(fw, fs, var, pos, unit, tol)
+    cols.update(links)
+    cols["energy"] = _energy(fw, pos, links)
+    return cols, reason, borderline
 
 
 def column_names(fw: Framework) -> list[str]:

@@ -16,6 +16,7 @@ if TYPE_CHECKING:  # the solve path only: a cache hit must not load numpy or pan
     from ..point import PointSolution
 
 SOLUTIONS_CSV = "solutions.csv"
+CONTINUA_CSV = "continua.csv"
 RUN_JSON = "run.json"
 COLUMNS_MD = "columns.md"
 FIGURE_STEMS = ("configurations", "energy_map")
@@ -54,6 +55,8 @@ def solve_record(point: PointSolution, tolerances: dict, label: str, key: str | 
         "timings": dict(point.timings),
         "cache_key": key,
     }
+    if point.continua:
+        record["continua"] = list(point.continua)
     record["summary"] = summary_text(record, point.columns)
     return record
 
@@ -63,6 +66,7 @@ def summary_head(record: dict, cached: bool = False) -> str:
     answer from the cache is labelled as the time of that earlier solve."""
     c, engine = record["counts"], record["engine"]
     closed = c["closed_form_endpoints"]
+    continua = c.get("continua", 0)
     seconds = f"{record['timings'].get('solve', 0.0):.2f} s"
     if cached:
         seconds = f"(cached: {seconds} when solved on {record.get('solved', '?')})"
@@ -74,7 +78,9 @@ def summary_head(record: dict, cached: bool = False) -> str:
         )
     return (
         f"{c['distinct_solutions']} distinct finite solutions "
-        f"({c['real']} real, {c['physical']} physical, {c['stable']} stable) from "
+        f"({c['real']} real, {c['physical']} physical, {c['stable']} stable"
+        + (f"; {continua} continua of equilibria apart" if continua else "")
+        + ") from "
         f"{c['finite_endpoints']} finite endpoints of {c['paths_tracked']} paths tracked"
         + (f" and {closed} computed in closed form" if closed else "")
         + f"; {engine['flavour']} ({engine['path']} {engine['version']}) {seconds}"
@@ -87,7 +93,45 @@ def summary_text(record: dict, table: dict) -> str:
     real = [k for k, r in enumerate(table["is_real"]) if r]
     if real:
         lines.append(_real_rows_text(table, real))
+    lines += [continuum_line(c) for c in record.get("continua", [])]
     return "\n".join(lines)
+
+
+def continuum_line(c: dict) -> str:
+    """One continuum of equilibria in a line: its taut set, shape, stability, energy, extent,
+    what ends it and its term in the Morse sum."""
+    extent = ", ".join(f"{p} {lo:.4f}..{hi:.4f}" for p, (lo, hi) in c["extent"].items())
+    ends = "; ".join(
+        "(" + ", ".join(f"{v:.4f}" for k, v in e.items() if k != "by") + f") where {e['by']}"
+        for e in c["ends"]
+    )
+    term = c["morse_term"]
+    return (
+        f"continuum {c['continuum']} (taut set {c['taut_set']}): a {c['dimension']}-dim "
+        f"{c['shape']} of {c['kind']}, energy {c['energy']:.4f}"
+        + (f"; {extent}" if extent else "")
+        + (f"; ends {ends}" if ends else "")
+        + (f"; Morse term {term}" if term is not None else f"; no Morse term: {c['morse_note']}")
+    )
+
+
+def continua_columns(continua: list[dict]) -> dict[str, list]:
+    """continua.csv: one row per continuum (docs/columns.md)."""
+    pose = list(continua[0]["extent"])
+    cols: dict[str, list] = {}
+    for c in continua:
+        ends = c["ends"] or [{}, {}]
+        row = {k: c[k] for k in ("continuum", "taut_set", "dimension", "shape", "kind",
+                                 "index_across", "energy", "energy_spread")}  # fmt: skip
+        for p in pose:
+            row[f"{p}.min"], row[f"{p}.max"] = c["extent"].get(p, [None, None])
+        for n, e in enumerate(ends, start=1):
+            row[f"end{n}_by"] = e.get("by", "")
+            row.update({f"end{n}.{p}": e.get(p) for p in pose})
+        row.update(points=c["points"], morse_term=c["morse_term"], morse_note=c["morse_note"])
+        for k, v in row.items():
+            cols.setdefault(k, []).append(v)
+    return cols
 
 
 def summary_columns(table: dict) -> list[str]:
@@ -126,8 +170,11 @@ def _real_rows_text(table: dict, rows: list[int]) -> str:
 def write_solution_files(folder: Path, point: PointSolution) -> None:
     """solutions.csv, columns.md and the input file (unless the solver wrote it)."""
     atomic_write_text(folder / SOLUTIONS_CSV, columns_csv(point.columns))
+    if point.continua:
+        atomic_write_text(folder / CONTINUA_CSV, columns_csv(continua_columns(point.continua)))
     paper = "gamma1_deg" in point.columns
     tables = ("solutions", "counts") if paper else ("framework", "framework_counts")
+    tables += ("framework_continua",) * bool(point.continua)
     atomic_write_text(folder / COLUMNS_MD, reference(*tables))
     if not (folder / "input").exists():
         atomic_write_text(folder / "input", point.input_text)

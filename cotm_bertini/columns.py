@@ -304,25 +304,35 @@ FRAMEWORK_SWEEP = {
 }
 
 FRAMEWORK_EVENTS = {
-    "kind": "fold (the number of physical equilibria changes by two: a pair is born or meets "
-    "and vanishes), physical_change (it changes by one: a length or a cable reaches its limit) "
-    "or stability_change (the number of stable ones changes; at a fold too)",
-    "branches": "the branch ids of the rows involved (a+b) at the neighbouring sweep point where "
-    "they exist: its physical rows nearest in pose to the event",
-    "<param>": "the event's parameter value: the middle of the final bisection bracket",
+    "kind": "what happens there: cable_switch (equilibria appear or vanish where a cable of theirs "
+    "reaches its free length: the taut and the slack branch end together, the Hessian regular, "
+    "so no fold), fold (the number of physical equilibria changes by two: a pair is born or "
+    "meets and vanishes, the reduced Hessian singular there), pitchfork (it changes by two on a "
+    "third equilibrium, present on both sides, through the pair's meeting point: a min and two "
+    "saddles, or a saddle and two minima, meet), physical_change "
+    "(it changes by one: a length reaches 0) or stability_change (the number of stable ones "
+    "changes; at the events above too)",
+    "branches": "the branch ids of the rows involved (a+b; a+b+c at a pitchfork, the third "
+    "branch among them) at the neighbouring sweep point where they exist: its physical rows "
+    "nearest in pose to the event",
+    "<param>": "the event's parameter value: the middle of the final bisection bracket; of a "
+    "cable switch, where the followed equilibrium's cable length equals its free length",
     "pose columns": "BODY.angle_deg (planar), BODY.qw ... (spatial), NODE.x ...: the mean pose "
     "of the equilibria that appear or vanish, at the bracket's end where they are real (those "
     "with no counterpart at the other end); of a stability change alone, of the row whose "
-    "smallest eigenvalue is nearest 0",
+    "smallest eigenvalue is nearest 0; of a cable switch, the followed equilibrium where its "
+    "cable is at its free length",
     "hess_min_eig": "the largest |smallest reduced-Hessian eigenvalue| of those equilibria there "
-    "(tends to 0 at a fold of a minimum and a saddle; at a fold of two saddles the eigenvalue "
-    "that crosses 0 is another one)",
+    "(tends to 0 at a fold of a minimum and a saddle and at a pitchfork; at a fold of two "
+    "saddles the eigenvalue that crosses 0 is another one; away from 0 at a cable switch)",
     "refined": "every probe that placed an end of the bracket was a complete solve (status ok); "
     "a probe that sees the event itself (counts matching neither end, with a degenerate row or "
-    "a failed check: at a fold, the merging pair taken as one root) places no end",
-    "bracket": "the final bisection bracket's width (the value's accuracy): 1e-9 relative, or as "
-    "narrow as the probes that see the event allow",
-    "description": "what happens, in words",
+    "a failed check: at a fold, the merging pair taken as one root) places no end; a cable "
+    "switch: also its secant converged",
+    "bracket": "the value's accuracy: the final bisection bracket's width (1e-9 relative, or as "
+    "narrow as the probes that see the event allow); of a cable switch, the secant's last step "
+    "on d - L0 of its cable (converged to 1e-9 relative)",
+    "description": "what happens, in words (a cable switch names its cable)",
     "lo, hi": "the sweep points on either side (where the counts change twice between them, "
     "each event is found and carries both)",
 }

@@ -21,6 +21,25 @@ def _quantities(fw: Framework, table: pd.DataFrame) -> list[str]:
     return [n for n in names if n in table][:6] or ["energy"]
 
 
+# Where equilibria are born or end: marker, face colour, label (the events.csv kinds).
+EVENT_MARKERS = {
+    "fold": ("x", "black", "fold"),
+    "pitchfork": ("P", "white", "pitchfork (three branches meet)"),
+    "cable_switch": ("s", "white", "cable switch (a cable at its free length)"),
+}
+
+
+def _mark_events(ax, events: pd.DataFrame, param: str, name: str) -> None:
+    """Each fold, pitchfork and cable switch at its pose, one legend entry a kind present."""
+    if name not in events:
+        return
+    for kind, (marker, face, label) in EVENT_MARKERS.items():
+        rows = events[events["kind"] == kind]
+        if len(rows):
+            ax.plot(rows[param], rows[name], marker, ls="", color="black", mfc=face, ms=7,
+                    mew=1.6, label=label)  # fmt: skip
+
+
 def plot_framework_sweep(
     fw: Framework, table: pd.DataFrame, param: str, path: str | Path, events=None
 ) -> list[Path]:
@@ -38,8 +57,7 @@ def plot_framework_sweep(
         if events is not None and len(events):
             for _, e in events.iterrows():
                 ax.axvline(e[param], color="0.5", lw=0.6, ls=":")
-                if name in e and e["kind"] == "fold":
-                    ax.plot([e[param]], [e[name]], "x", color="black", ms=7, mew=1.6)
+            _mark_events(ax, events, param, name)
         ax.set_ylabel(name)
         ax.grid(alpha=0.3)
     axes[-1].set_xlabel(param)

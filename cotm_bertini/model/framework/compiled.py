@@ -78,7 +78,7 @@ def check_terms(fw: Framework, fs: FrameworkSystem, slots: dict[str, float]) -> 
     system = fs.ps.instantiate([slots[n] for n in fs.ps.parameters])
     for what, coeffs in zip(fs.descriptions, system.coefficients, strict=True):
         if not len(coeffs):
-            values = ", ".join(f"{p} = {v!r}" for p, v in fw.parameters) or "its values"
+            values = ", ".join(f"{p} = {v:.15g}" for p, v in fw.parameters) or "its values"
             raise ParameterError(
                 f"{values}: framework {fw.name!r}, equation {what}: every term is 0 there "
                 "(nothing resists that motion at these values: a continuum of equilibria)"

@@ -382,7 +382,7 @@ def check_values(fw: Framework) -> None:
     for name, value in s.items():
         if not math.isfinite(value):
             where, expr = fields[name]
-            at = ", ".join(f"{p} = {v!r}" for p, v in fw.parameters if p in expr.names())
+            at = ", ".join(f"{p} = {v:.15g}" for p, v in fw.parameters if p in expr.names())
             raise ParameterError(
                 f"{where} = {expr.source()!r}: evaluates to {value!r}{' at ' + at if at else ''}"
                 " (a division by zero, or a negative number to a fractional power)"
@@ -400,15 +400,16 @@ def check_values(fw: Framework) -> None:
 def _refusal(
     fw: Framework, slots: list[str], subject: str, problem: str, holds=None
 ) -> ParameterError:
-    """One line: the parameters behind `slots` with their values ("L1 = 0.0: makes ..."), what
-    they make and the problem; a literal of the file is named by `subject` alone. `holds(fw)`,
+    """One line: the parameters behind `slots` with their values ("L1 = 0: makes ..."), what
+    they make and the problem (-1e+15, not -1000000000000000.0); a literal of the file is named
+    by `subject` alone. `holds(fw)`,
     if given, says whether the problem persists at other values: a parameter is named only if
     moving it away ends the problem (h of a mast [0, 0, h] does not make it a line)."""
     exprs = fw.slot_expressions()
     used = set().union(*(exprs[n].names() for n in slots))
     if holds is not None:
         used = {p for p in used if not holds(_moved(fw, p))}
-    who = ", ".join(f"{p} = {v!r}" for p, v in fw.parameters if p in used)
+    who = ", ".join(f"{p} = {v:.15g}" for p, v in fw.parameters if p in used)
     return ParameterError(f"{who}: makes {subject}{problem}" if who else f"{subject}{problem}")
 
 

@@ -51,8 +51,9 @@ CASES = {
 
 LENGTHS = ("L3", "p2x", "p3x", "p3y", "p6x", "p5x", "p5y", "L01", "L02")
 
-# Two points of one body closer than this (relative to L3) are "coincident".
-_COINCIDENT_REL = 1e-9
+# Two points of one body closer than this (relative to L3; a framework: its length unit) are
+# "coincident".
+COINCIDENT_REL = 1e-9
 # The solvers work in units where the numbers are of order one (normalized(); a framework's
 # units); a number more than this many times its unit leaves too few digits of double
 # precision for the others, and the equations say nothing (Bertini then fails or finds nothing).
@@ -170,7 +171,7 @@ def validate(p: Params) -> None:
         if getattr(p, name) < 0:
             raise ParameterError(f"{name} = {getattr(p, name)!r}: a free length must be >= 0")
     _check_scale(p)
-    _check_distinct_points(p, _COINCIDENT_REL * p.L3)
+    _check_distinct_points(p, COINCIDENT_REL * p.L3)
 
 
 def _check_scale(p: Params) -> None:

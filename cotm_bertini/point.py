@@ -384,7 +384,7 @@ def _solve_taut_set(fw, taut, unit, target, centre, settings, tolerances, t: Tim
     from .analysis.framework_checks import continuum_check
     from .analysis.framework_classify import framework_rows
     from .backends.target import solve_parameters
-    from .model.framework.compiled import framework_system, variable_groups
+    from .model.framework.compiled import check_terms, framework_system, variable_groups
 
     with t.stage("derive"):
         fs = framework_system(fw, taut)
@@ -392,6 +392,7 @@ def _solve_taut_set(fw, taut, unit, target, centre, settings, tolerances, t: Tim
         # With these cables slack something moves freely: equilibria there form a continuum,
         # which matters only where every cable of the set can be slack at once.
         return None, continuum_check(fw, fs, unit), ""
+    check_terms(fw, fs, target)  # a degenerate equation: refused, not solved
     with t.stage("solve"):
         hs = solve_parameters(
             fs.ps, target, centre, settings, variable_groups(fs), warm[0].get(fs.key)

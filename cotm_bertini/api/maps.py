@@ -104,18 +104,20 @@ def design_map(
     its parameters. The paper's mechanism: design_map(params, l01=(0, 14), l02=(0, 14),
     points=101) (or positionally design_map(params, (0, 14), (0, 14), 101))."""
     from ..continuation.runner import check_workers
+    from ..continuation.spec import check_grid
     from .sweeps import sweep
 
     (x, xr), (y, yr), points = map_axes(model, axes, l01, l02, points)
     for a in xr:  # the window's corners validated before any work is announced or done
         for b in yr:
             model.replace(**{x: a, y: b})
+    xs, ys = grid_values(*xr, points), grid_values(*yr, points)
+    check_grid(model, x, tuple(map(float, xs)), y, tuple(map(float, ys)))  # every point too
     t0 = time.perf_counter()
     say(f"map: fold curves in the window {x} {xr[0]:g}..{xr[1]:g}, {y} {yr[0]:g}..{yr[1]:g}")
     check_workers(workers)  # before any process starts
     job = (model, x, xr, y, yr, settings, workers)
     aside = _FoldsAside(job) if isinstance(model, Params) and workers > 1 else None
-    xs, ys = grid_values(*xr, points), grid_values(*yr, points)
     if aside is None:
         folds, fold_record, t_folds = _timed_folds(job)
         say(f"map: {len(folds)} fold points in {duration(t_folds)}; now the stable counts on a "

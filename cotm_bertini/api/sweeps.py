@@ -138,7 +138,7 @@ def sweep(
     is proved as `cb.certify` proves a solve (columns certified, certified_radius, certificate).
     """
     from ..continuation.runner import check_workers, prepare
-    from ..continuation.spec import SweepSpec
+    from ..continuation.spec import SweepSpec, check_grid
 
     check_workers(workers)  # before any folder is made
     settings = (settings or Settings()).replace(**options)
@@ -151,6 +151,7 @@ def sweep(
         params.as_dict(), param, tuple(values), param2,
         None if values2 is None else tuple(values2), settings.as_dict(), certify, framework,
     )  # fmt: skip
+    check_grid(params, param, spec.values, param2, spec.values2)  # before any folder is made
     root = cache_root() / "sweeps" if out is None else output_root(out, "out")
     folder = prepare(spec, root / spec.folder_name())
     return _run(spec, folder, workers, scheduler, progress, command)

@@ -29,7 +29,10 @@ def encode(fw: Framework) -> dict:
 def _encode(value):
     if dataclasses.is_dataclass(value):
         out = {"__type__": type(value).__name__}
-        out.update({f.name: _encode(getattr(value, f.name)) for f in dataclasses.fields(value)})
+        # Fields outside equality (an expression's text, for messages) stay out: the data
+        # is part of a sweep's key, which they must not change.
+        out.update({f.name: _encode(getattr(value, f.name))
+                    for f in dataclasses.fields(value) if f.compare})  # fmt: skip
         return out
     if isinstance(value, tuple | list):
         return [_encode(v) for v in value]

@@ -6,6 +6,7 @@ import hashlib
 import json
 import math
 from dataclasses import asdict, dataclass, field
+from functools import lru_cache
 from itertools import product
 
 from .._version import __version__
@@ -34,6 +35,24 @@ def _values(name: str, option: str, values) -> tuple[float, ...]:
             "more than once)"
         )
     return out
+
+
+@lru_cache(maxsize=8)  # a map checks its grid before its fold curves, its sweep again
+def check_grid(model, param: str, values: tuple, param2=None, values2=None) -> None:
+    """Every point of a sweep's grid validated before any work (`model`: Params or Framework;
+    SweepSpec checks the ends): a range that crosses a refused value (a body of zero size, two
+    points of one body that meet, ...) is refused naming that point, not met mid-sweep."""
+    grid = ([{param: v} for v in values] if param2 is None
+            else [{param: u, param2: w} for u, w in product(values, values2)])  # fmt: skip
+    for k, point in enumerate(grid):
+        try:
+            model.replace(**point)
+        except ParameterError as err:
+            where = ", ".join(f"{n} = {v!r}" for n, v in point.items())
+            raise ParameterError(
+                f"{err} (at {where}, point {k + 1} of the {len(grid)} of the range: choose a "
+                "range or a number of points that avoids it)"
+            ) from None
 
 
 @dataclass(frozen=True)

@@ -8,6 +8,8 @@ from functools import cached_property
 
 import numpy as np
 
+from ..errors import ParameterError
+
 
 @dataclass(frozen=True)
 class Subfunctions:
@@ -334,4 +336,10 @@ class PolySystem:
 
     def scale(self) -> np.ndarray:
         """Largest coefficient magnitude of each function, to make residuals relative."""
+        empty = [n for n, c in zip(self.names, self.coefficients, strict=True) if not len(c)]
+        if empty:  # every point solves it: no residual to scale, and no finite set of roots
+            raise ParameterError(
+                f"equation {empty[0]} has no terms at these parameter values (every "
+                "coefficient is 0): the system is degenerate there"
+            )
         return np.array([np.abs(c).max() for c in self.coefficients])

@@ -13,6 +13,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from ...errors import ParameterError
 from ...fs import atomic_write_text, cache_root
 from ..polynomial import ParametricSystem
 from .spec import Framework
@@ -68,6 +69,20 @@ def framework_system(fw: Framework, taut: tuple[str, ...], label: str = "") -> F
     )  # fmt: skip
     _LOADED[key] = out
     return out
+
+
+def check_terms(fw: Framework, fs: FrameworkSystem, slots: dict[str, float]) -> None:
+    """Refuse values (`slots`, normalized) at which an equation loses every term: what
+    spec.check_geometry refuses and anything it does not foresee; solving would find a
+    continuum, or a numpy traceback, not equilibria."""
+    system = fs.ps.instantiate([slots[n] for n in fs.ps.parameters])
+    for what, coeffs in zip(fs.descriptions, system.coefficients, strict=True):
+        if not len(coeffs):
+            values = ", ".join(f"{p} = {v:.15g}" for p, v in fw.parameters) or "its values"
+            raise ParameterError(
+                f"{values}: framework {fw.name!r}, equation {what}: every term is 0 there "
+                "(nothing resists that motion at these values: a continuum of equilibria)"
+            )
 
 
 def cached_derivation(name: str, kind: type, derive) -> tuple:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 from ...errors import ParameterError
 
@@ -20,12 +20,23 @@ class Expr:
     args: tuple = ()
     value: float = 0.0
     name: str = ""
+    # The file's text, for messages; not part of equality, hashing or repr (cache keys).
+    text: str = field(default="", compare=False, repr=False)
 
     def names(self) -> set[str]:
         """The parameter names the expression uses."""
         if self.op == "name":
             return {self.name}
         return set().union(*(a.names() for a in self.args)) if self.args else set()
+
+    def source(self) -> str:
+        """The expression as the file wrote it (or, once decoded without it, rebuilt)."""
+        if self.text:
+            return self.text
+        if self.op in ("num", "name"):
+            return repr(self.value) if self.op == "num" else self.name
+        a = [x.source() for x in self.args]
+        return f"-({a[0]})" if self.op == "neg" else f"({a[0]} {self.op} {a[1]})"
 
     def evaluate(self, values: dict[str, float]) -> float:
         """The value with the parameters set to `values`."""
@@ -140,7 +151,7 @@ def parse(value: object, where: str) -> Expr:
     if not isinstance(value, str):
         if not math.isfinite(float(value)):
             raise ParameterError(f"{where} = {value!r}: must be finite")
-        return Expr("num", value=float(value))
+        return Expr("num", value=float(value), text=repr(value))
     tokens = _tokens(value, where)
     if not tokens:
         raise ParameterError(f"{where} = {value!r}: empty expression")
@@ -148,4 +159,4 @@ def parse(value: object, where: str) -> Expr:
     expr = parser.sum()
     if parser.peek() is not None:
         raise parser.fail(f"unexpected {parser.peek()[1]!r}")
-    return expr
+    return replace(expr, text=value)

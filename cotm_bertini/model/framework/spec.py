@@ -13,10 +13,11 @@ import math
 import re
 from dataclasses import dataclass, replace
 from functools import lru_cache
+from itertools import combinations
 from pathlib import Path
 
 from ...errors import ParameterError
-from ...params import SCALE_LIMIT, read_toml
+from ...params import COINCIDENT_REL, SCALE_LIMIT, read_toml
 from .expressions import Expr, parse
 
 _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
@@ -134,23 +135,28 @@ class Framework:
         """A body's points in its own frame."""
         return dict(dict(self.bodies)[body])
 
-    def slot_expressions(self) -> dict[str, Expr]:
-        """Every number of the equations as the file's expression of the parameters."""
-        out: dict[str, Expr] = {}
+    def slot_fields(self) -> dict[str, tuple[str, Expr]]:
+        """Each slot's field of the file and its expression (L0_top: springs.top.L0)."""
+        out: dict[str, tuple[str, Expr]] = {}
         for name, coords in self.ground:
-            out.update(_named_coords(f"g_{name}", coords))
+            out.update(_named_coords(f"g_{name}", f"ground.{name}", coords))
         for body, pts in self.bodies:
             for name, coords in pts:
-                out.update(_named_coords(f"b_{body}_{name}", coords))
+                out.update(_named_coords(f"b_{body}_{name}", f"bodies.{body}.{name}", coords))
         for link in self.links:
+            where = f"{link.kind}s.{link.name}"
             if link.kind == "bar":
-                out[f"len_{link.name}"] = link.length
+                out[f"len_{link.name}"] = (f"{where}.length", link.length)
             else:
-                out[f"k_{link.name}"] = link.k
-                out[f"L0_{link.name}"] = link.L0
+                out[f"k_{link.name}"] = (f"{where}.k", link.k)
+                out[f"L0_{link.name}"] = (f"{where}.L0", link.L0)
         for load in self.loads:
-            out.update(_named_coords(f"f_{load.name}", load.force))
+            out.update(_named_coords(f"f_{load.name}", f"loads.{load.name}.force", load.force))
         return out
+
+    def slot_expressions(self) -> dict[str, Expr]:
+        """Every number of the equations as the file's expression of the parameters."""
+        return {n: e for n, (_, e) in self.slot_fields().items()}
 
     def slots(self) -> dict[str, float]:
         """Every number of the equations, evaluated at the parameter values."""
@@ -167,8 +173,8 @@ class Framework:
         return tuple(x.name for x in self.links if x.kind != "bar" and s[f"L0_{x.name}"] == 0)
 
 
-def _named_coords(prefix: str, coords: tuple[Expr, ...]) -> dict[str, Expr]:
-    return {f"{prefix}_{'xyz'[k]}": e for k, e in enumerate(coords)}
+def _named_coords(prefix: str, where: str, coords: tuple[Expr, ...]) -> dict:
+    return {f"{prefix}_{'xyz'[k]}": (f"{where}[{k}]", e) for k, e in enumerate(coords)}
 
 
 def _number(where: str, value: object) -> float:
@@ -249,9 +255,24 @@ def from_dict(data: dict, source: str = "") -> Framework:
         pins=_pins(data.get("pins", [])), links=_links(data, params),
         loads=_loads(data.get("loads", []), dim, params), source=source, defaults=parameters,
     )  # fmt: skip
+    check_elements(fw)
     check_names(fw)
     check_values(fw)
     return fw
+
+
+def check_elements(fw: Framework) -> None:
+    """Something that moves and something that acts on it: else the file names no mechanism."""
+    missing = []
+    if not fw.bodies and not fw.nodes:
+        missing.append("no bodies or nodes (nothing moves)")
+    if not fw.links and not fw.loads:
+        missing.append("no springs, cables, bars or loads (nothing acts)")
+    if missing:
+        raise ParameterError(
+            f"framework {fw.name!r}{' (' + fw.source + ')' if fw.source else ''} has no "
+            f"elements: {' and '.join(missing)}; docs/frameworks.md shows a file's sections"
+        )
 
 
 def _body(body: str, pts: object, dim: int, params: set[str]) -> tuple:
@@ -353,22 +374,152 @@ def check_names(fw: Framework) -> None:
 
 
 def check_values(fw: Framework) -> None:
-    """Stiffness > 0, free lengths >= 0, bar lengths > 0, every slot finite."""
-    s = fw.slots()
+    """Every slot finite, stiffness > 0, free lengths >= 0, bar lengths > 0, no body or element
+    of zero size, every number within double precision's reach. Run on the values as set (the
+    file's, --set, replace, each point of a sweep), so a parameter is refused as the literal it
+    stands for would be, and the line names the parameter."""
+    s, fields = fw.slots(), fw.slot_fields()
     for name, value in s.items():
         if not math.isfinite(value):
-            raise ParameterError(f"{name} = {value!r}: evaluates to a non-finite number")
+            where, expr = fields[name]
+            at = ", ".join(f"{p} = {v:.15g}" for p, v in fw.parameters if p in expr.names())
+            raise ParameterError(
+                f"{where} = {expr.source()!r}: evaluates to {value!r}{' at ' + at if at else ''}"
+                " (a division by zero, or a negative number to a fractional power)"
+            )
     for x in fw.links:
-        where = f"{x.kind}s.{x.name}"
-        if x.kind == "bar":
-            if s[f"len_{x.name}"] <= 0:
-                raise ParameterError(f"{where}.length = {s[f'len_{x.name}']!r}: must be > 0")
-            continue
-        if s[f"k_{x.name}"] <= 0:
-            raise ParameterError(f"{where}.k = {s[f'k_{x.name}']!r}: must be > 0")
-        if s[f"L0_{x.name}"] < 0:
-            raise ParameterError(f"{where}.L0 = {s[f'L0_{x.name}']!r}: must be >= 0")
+        rules = [("len_", "> 0")] if x.kind == "bar" else [("k_", "> 0"), ("L0_", ">= 0")]
+        for prefix, rule in rules:
+            slot = prefix + x.name
+            if s[slot] < 0 or (s[slot] == 0 and rule == "> 0"):
+                raise _refusal(fw, [slot], f"{fields[slot][0]} = {s[slot]!r}", f": must be {rule}")
+    check_geometry(fw)
     check_scale(fw)
+
+
+def _refusal(
+    fw: Framework, slots: list[str], subject: str, problem: str, holds=None
+) -> ParameterError:
+    """One line: the parameters behind `slots` with their values ("L1 = 0: makes ..."), what
+    they make and the problem (-1e+15, not -1000000000000000.0); a literal of the file is named
+    by `subject` alone. `holds(fw)`,
+    if given, says whether the problem persists at other values: a parameter is named only if
+    moving it away ends the problem (h of a mast [0, 0, h] does not make it a line)."""
+    exprs = fw.slot_expressions()
+    used = set().union(*(exprs[n].names() for n in slots))
+    if holds is not None:
+        used = {p for p in used if not holds(_moved(fw, p))}
+    who = ", ".join(f"{p} = {v:.15g}" for p, v in fw.parameters if p in used)
+    return ParameterError(f"{who}: makes {subject}{problem}" if who else f"{subject}{problem}")
+
+
+def _moved(fw: Framework, name: str) -> Framework:
+    """The framework with one parameter moved well away from its value (not validated)."""
+    moved = tuple(
+        (p, v * 1.618 + 0.577 * (abs(v) + 1) if p == name else v) for p, v in fw.parameters
+    )
+    return replace(fw, parameters=moved)
+
+
+def _frame_points(fw: Framework) -> dict[str, list[tuple[str, list[str], tuple[float, ...]]]]:
+    """Per rigid frame (the ground, each body): its points, their slots and coordinates."""
+    vals, out = fw.values, {}
+    frames = [("ground", "g_", fw.ground)] + [(b, f"b_{b}_", p) for b, p in fw.bodies]
+    for frame, prefix, pts in frames:
+        out[frame] = [
+            (f"{frame}.{n}", [f"{prefix}{n}_{'xyz'[k]}" for k in range(len(c))],
+             tuple(e.evaluate(vals) for e in c))
+            for n, c in pts
+        ]  # fmt: skip
+    return out
+
+
+def _flat(coords: list[tuple[float, ...]], tol: float) -> str | None:
+    """'coincide' if a body's points (two or more) do, 'lie on one line' if they lie on one
+    line (which matters in space only), else None."""
+    if len(coords) < 2:
+        return None  # a one-point body: refused by its derivation (its rotation moves nothing)
+    first = coords[0]
+    far = max(coords, key=lambda c: math.dist(c, first))
+    reach = math.dist(far, first)
+    if reach <= tol:
+        return "coincide"
+    u = [(a - b) / reach for a, b in zip(far, first, strict=True)]
+    off = 0.0
+    for c in coords:
+        d = [a - b for a, b in zip(c, first, strict=True)]
+        along = sum(x * y for x, y in zip(d, u, strict=True))
+        off = max(off, math.dist(d, [along * x for x in u]))
+    return "lie on one line" if off <= tol else None
+
+
+_FLAT_WHY = {
+    "coincide": "nothing then fixes its rotation (a body needs two distinct points)",
+    "lie on one line": "nothing resists its spin about that line (a spatial body needs three "
+    "points not on one line)",
+}
+
+
+def _joined(fw: Framework, frames: dict, tol: float) -> dict[str, str]:
+    """Each point's class of points that are one point in every pose: joined by pins, or
+    coincident points of one frame (`frames`: _frame_points); a class is named by a member."""
+    parent = {p: p for pts in frames.values() for p, _, _ in pts} | {n: n for n in fw.nodes}
+
+    def find(p: str) -> str:
+        while parent[p] != p:
+            p = parent[p]
+        return p
+
+    for a, b in fw.pins:
+        parent[find(a)] = find(b)
+    for pts in frames.values():
+        for (p, _, c), (q, _, d) in combinations(pts, 2):
+            if math.dist(c, d) <= tol:
+                parent[find(p)] = find(q)
+    return {p: find(p) for p in parent}
+
+
+def check_geometry(fw: Framework) -> None:
+    """No body whose points coincide (or, spatial, lie on one line: nothing fixes its rotation,
+    or its spin about that line) and no spring, cable or bar whose two ends are one point in
+    every pose: at such values an equation loses every term, and a continuum of equilibria or
+    none is all there is to find. The line names the parameters that make it so."""
+    tol = COINCIDENT_REL * units(fw)[0]
+    frames = _frame_points(fw)
+
+    def flat(f: Framework, body: str, points=None) -> str | None:
+        what = _flat([c for _, _, c in (points or _frame_points(f))[body]], tol)
+        return None if what == "lie on one line" and fw.dim == 2 else what
+
+    for body, pts in fw.bodies:
+        what = flat(fw, body, frames)
+        if what is not None:
+            names = [p for p, _ in pts]
+            listed = ", ".join(names[:-1]) + " and " + names[-1]
+            raise _refusal(
+                fw, [f"b_{body}_{n}_{'xyz'[k]}" for n in names for k in range(fw.dim)],
+                f"body {body}'s points {listed} {what}", f"; {_FLAT_WHY[what]}",
+                holds=lambda f, b=body: flat(f, b) is not None,
+            )  # fmt: skip
+    same = _joined(fw, frames, tol)
+    for x in fw.links:
+        if same[x.a] == same[x.b]:
+            joined = [p for p in same if same[p] == same[x.a]]
+            slots = [n for n in fw.slot_fields() if any(_is_slot_of(n, p) for p in joined)]
+            raise _refusal(
+                fw, slots, f"{x.kind}s.{x.name}'s ends {x.a} and {x.b} meet in every pose",
+                f" (pins and coincident points of one body or the ground join "
+                f"{', '.join(joined)}); "
+                + ("no pose holds its length" if x.kind == "bar" else "its pull has no direction"),
+                holds=lambda f, x=x: (s := _joined(f, _frame_points(f), tol))[x.a] == s[x.b],
+            )  # fmt: skip
+
+
+def _is_slot_of(slot: str, point: str) -> bool:
+    """Whether `slot` is a coordinate of `point` (ground.a: g_a_x, bar1.tip: b_bar1_tip_y)."""
+    frame, _, name = point.partition(".")
+    prefix = f"g_{name}_" if frame == "ground" else f"b_{frame}_{name}_"
+    return bool(name) and slot.startswith(prefix) and len(slot) == len(prefix) + 1
 
 
 # How each slot scales with the length unit L and the stiffness unit k.
@@ -403,18 +554,17 @@ def check_scale(fw: Framework) -> None:
     times the file's own unit of its kind, or a bar length or stiffness under 1/SCALE_LIMIT of
     it. The message names the parameters behind the number."""
     length, stiffness = units(fw)
-    exprs = fw.slot_expressions()
+    fields = fw.slot_fields()
     for name, value in fw.slots().items():
         unit = scale_of(slot_kind(name), length, stiffness)
         ratio = abs(value) / unit
         tiny = name.startswith(("len_", "k_")) and ratio < 1 / SCALE_LIMIT
         if ratio <= SCALE_LIMIT and not tiny:
             continue
-        used = sorted(exprs[name].names())
-        who = ", ".join(f"{p} = {fw.values[p]!r}" for p in used) or f"{name} = {value!r}"
         bound = f"under {1 / SCALE_LIMIT:g}" if tiny else f"over {SCALE_LIMIT:g}"
-        raise ParameterError(
-            f"{who}: makes {name} = {value:.6g}, {bound} times the file's "
-            f"{_UNIT_NAMES[slot_kind(name)]} {unit:.6g}; double precision cannot solve that "
-            "(keep every number within 1e12 of the file's own values)"
-        )
+        raise _refusal(
+            fw, [name], f"{fields[name][0]} = {value:.6g}",
+            f", {bound} times the file's {_UNIT_NAMES[slot_kind(name)]} {unit:.6g}; double "
+            "precision cannot solve that (keep every number within 1e12 of the file's own "
+            "values)",
+        )  # fmt: skip

@@ -297,7 +297,7 @@ def _solve_real(fw, settings: Settings, tolerances: Tolerances, t: Timings) -> P
                 parts.append(framework_columns(fw, framework_system(fw, taut), eps, unit,
                                                tolerances))  # fmt: skip
         table = order_rows(fw, parts)
-        checks = completeness(fw, table, report)
+        checks = completeness(fw, table, report, near_cones=found.set_aside_boxes)
     search_info = real_search_info(found, unit[0])
     warnings = tuple(search_info["warnings"] + checks["warnings"])
     counts = {**framework_counts(table, report), "boxes": found.boxes}

@@ -238,3 +238,22 @@ def test_route_real_is_refused_where_it_does_not_cover_the_space():
         cb.solve(fw, route="real")
     with pytest.raises(cb.ParameterError, match="route = 'bogus'"):
         cb.Settings(route="bogus")
+
+
+@pytest.mark.parametrize("name", ["xmodule", "cotm"])
+def test_cone_points_from_the_search_equal_bertinis(name):
+    """The zero-length poses the Morse count needs, by Newton from the boxes the search set
+    aside, against Bertini's ab-initio solve of the same system."""
+    from cotm_bertini.analysis.framework_checks import cone_points
+    from cotm_bertini.backends.boxes import MIN_WIDTH, SHORT, search
+    from cotm_bertini.backends.real_route import TorusFramework
+
+    fw = cb.Framework.from_toml(ROOT / "examples" / f"{name}.toml")
+    found = search(TorusFramework(fw), SHORT, MIN_WIDTH)
+    near = cone_points(fw, found.set_aside_boxes)
+    ref = cone_points(fw)
+    assert len(ref) == len(near) > 0
+    for c in ref:
+        gaps = [np.abs(np.array(c["pose"]) - np.array(d["pose"])).max() for d in near]
+        k = int(np.argmin(gaps))
+        assert gaps[k] < 1e-9 and near[k]["is_max"] == c["is_max"]

@@ -86,7 +86,9 @@ def framework_counts(table: dict, report: dict, continua: list = ()) -> dict:
     }
 
 
-def completeness(fw: Framework, table: dict, report: dict, continua: list = ()) -> dict:
+def completeness(
+    fw: Framework, table: dict, report: dict, continua: list = (), near_cones=None
+) -> dict:
     """Why no equilibrium is missing, or warnings saying why one may be: {"morse", "warnings"}
     (`continua`: analysis.framework_continua's, each a term of the Morse sum)."""
     warnings = []
@@ -111,7 +113,7 @@ def completeness(fw: Framework, table: dict, report: dict, continua: list = ()) 
                 f"taut set {label}: {info['generic_singular']} singular endpoints at generic "
                 "parameters (a positive-dimensional solution set, not enumerated)"
             )
-    morse = morse_count(fw, table, continua)
+    morse = morse_count(fw, table, continua, near_cones)
     if morse.get("continuum_unknown"):
         warnings.append(f"{morse['reason']}: the Morse check is not applicable, so equilibria "
                         "may be missing")  # fmt: skip
@@ -156,7 +158,7 @@ def _collapsible(fw: Framework) -> list[str]:
             if slots[f"L0_{x.name}"] > 0 and length_bounds(fw, x.a, x.b)[0] <= 0]  # fmt: skip
 
 
-def morse_count(fw: Framework, table: dict, continua: list = ()) -> dict:
+def morse_count(fw: Framework, table: dict, continua: list = (), near_cones=None) -> dict:
     """sum (-1)^index over the physical equilibria (plus the cone maxima, plus each continuum's
     term: docs/frameworks.md) must equal the Euler characteristic of the configuration space: 0
     for a torus, 2^n for n spheres S2."""
@@ -178,7 +180,7 @@ def morse_count(fw: Framework, table: dict, continua: list = ()) -> dict:
     kinds = np.asarray(table["kind"], dtype=object)[phys]
     index = np.asarray(table["index"], dtype=int)[phys]
     counts = {k: int((kinds == k).sum()) for k in ("min", "saddle", "max", "degenerate")}
-    maxima = sum(c["is_max"] for c in cone_points(fw)) if torus2 else 0
+    maxima = sum(c["is_max"] for c in cone_points(fw, near_cones)) if torus2 else 0
     total = int(sum((-1) ** int(i) for i, k in zip(index, kinds, strict=True) if k != "degenerate"))
     total += maxima * (-1) ** len(factors) + sum(t for t, _ in terms)
     # V is continuous on the compact configuration space: its global minimum is an equilibrium
@@ -192,9 +194,11 @@ def morse_count(fw: Framework, table: dict, continua: list = ()) -> dict:
             "ok": ok}  # fmt: skip
 
 
-def cone_points(fw: Framework) -> list[dict]:
+def cone_points(fw: Framework, near: np.ndarray | None = None) -> list[dict]:
     """Real poses of a two-body planar torus where a spring with L0 > 0 has zero length; each is
-    a local maximum of V (a cone) when the other elements' pull there is weaker than k L0."""
+    a local maximum of V (a cone) when the other elements' pull there is weaker than k L0.
+    Solved by Bertini, or, given `near` (angle boxes (A, 4) as lo1, lo2, hi1, hi2 in radians that
+    hold every such pose: the real search's boxes set aside), by Newton from their middles."""
     fs = framework_system(fw, tuple(c.name for c in fw.cables))
     if not fs.cones:
         return []
@@ -203,14 +207,39 @@ def cone_points(fw: Framework) -> list[dict]:
     slots_n = normalized_slots(fw)
     found = []
     for name, ps in fs.cones.items():
-        ends, _ = ab_initio(ps, {n: slots_n[n] for n in ps.parameters}, Settings())
-        for pose in ends.points:
+        if near is None:
+            points = ab_initio(ps, {n: slots_n[n] for n in ps.parameters}, Settings())[0].points
+        else:
+            points = _cones_near(fw, ps, slots_n, near)
+        for pose in points:
             if np.abs(pose.imag).max() > 1e-8:
                 continue
             pull, push = _cone_pull(fw, fs, name, pose.real, slots_n)
             found.append({"spring": name, "pose": pose.real.tolist(), "pull": pull,
                           "push": push, "is_max": pull < push})  # fmt: skip
     return found
+
+
+def _cones_near(fw: Framework, ps, slots_n: dict, near: np.ndarray) -> np.ndarray:
+    """The zero-length poses of one spring (system `ps`) that Newton reaches from the middles of
+    the boxes `near` (lo1, lo2, hi1, hi2 rad), each once."""
+    from ..model.framework.structure import layout
+    from .refine import newton_refine
+
+    bodies = layout(fw).rotations
+    n = len(bodies)
+    mid = 0.5 * (near[:, :n] + near[:, n:]) if len(near) else np.zeros((0, n))
+    x0 = np.zeros((len(mid), len(ps.variables)), dtype=complex)
+    for k, v in enumerate(ps.variables):
+        head, _, body = v.partition("_")
+        x0[:, k] = (np.cos if head == "c" else np.sin)(mid[:, bodies.index(body)])
+    system = ps.instantiate([slots_n[n] for n in ps.parameters])
+    x, res = newton_refine(system, x0, 12)
+    found: list[np.ndarray] = []
+    for pose in x[res < 1e-10]:
+        if all(np.abs(pose - f).max() > 1e-8 for f in found):
+            found.append(pose)
+    return np.array(found).reshape(-1, len(ps.variables))
 
 
 def _cone_pull(fw, fs: FrameworkSystem, name: str, pose, slots_n) -> tuple[float, float]:

@@ -14,8 +14,8 @@ is not smooth at length 0. Each box is
 - or split along its wide sides; a box that reaches the smallest width undecided is listed.
 
 A box with one critical point gives a root: Newton in double precision from the middle of
-K(X) n X, on the same enclosures taken at a point. Boxes are rows of two (B, n) arrays, lo and hi,
-in radians; the domain is [offset, offset + 2 pi]^n, with an offset that is no simple fraction
+K(X) n X, in double precision. Boxes are rows of two (B, n) arrays, lo and hi, in radians (a
+box listed in a result is one row lo_1..lo_n, hi_1..hi_n); the domain is [offset, offset + 2 pi]^n, with an offset that is no simple fraction
 of pi so that no symmetric pose falls on the edges of the first grid or of its halvings.
 """
 
@@ -52,6 +52,9 @@ class BoxLandscape(Protocol):
     def hessian(self, box: Interval, states: object) -> Interval:
         """A slope matrix of grad V over each box (B, n, n)."""
 
+    def derivatives(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """grad V and its Hessian at points (R, n) in double precision."""
+
 
 @dataclass
 class BoxSearch:
@@ -63,6 +66,7 @@ class BoxSearch:
     newton_failed: int  # 'one' boxes where Newton did not converge inside K(X) (kept: mid K)
     set_aside: int
     set_aside_bound: float  # every spring is at most this long somewhere in each box set aside
+    set_aside_boxes: np.ndarray  # (A, 2n): where the cone points are (each lies in one)
     undecided: np.ndarray  # (U, 2n)
     boxes: int
     seconds: float
@@ -102,7 +106,8 @@ def search(
     n = land.n
     stack = [initial_boxes(n, start)]
     roots, root_boxes, undecided = [], [], []
-    acc = {"boxes": 0, "aside": 0, "bound": 0.0, "shortest": math.inf, "failed": 0}
+    acc = {"boxes": 0, "aside": 0, "bound": 0.0, "shortest": math.inf, "failed": 0,
+           "aside_boxes": []}  # fmt: skip
     pending, budget = 1.0, ""
     report = Progress(label, 1.0, "of the poses decided")
     while stack:
@@ -128,12 +133,16 @@ def search(
         pending -= share
         report.set(1.0 - pending, note=f"{acc['boxes']:,} boxes")
     report.close()
-    undec = np.vstack(undecided) if undecided else np.zeros((0, 2 * n))
+    undec = _rows(undecided, n)
     return BoxSearch(
         np.array(roots).reshape(-1, n), np.array(root_boxes).reshape(-1, 2 * n), acc["failed"],
-        acc["aside"], acc["bound"], undec, acc["boxes"], time.perf_counter() - t0,
+        acc["aside"], acc["bound"], _rows(acc["aside_boxes"], n), undec, acc["boxes"], time.perf_counter() - t0,
         acc["shortest"], budget,
     )  # fmt: skip
+
+
+def _rows(parts: list, n: int) -> np.ndarray:
+    return np.vstack(parts) if parts else np.zeros((0, 2 * n))
 
 
 def _take(stack: list, count: int) -> tuple[np.ndarray, np.ndarray]:
@@ -157,6 +166,7 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, acc: dict)
         aside = (dd.hi < short * short).any(axis=1) | (~smooth & (width <= min_width))
         if aside.any():
             acc["aside"] += int(aside.sum())
+            acc["aside_boxes"].append(np.hstack([lo[aside], hi[aside]]))
             longest = np.sqrt(np.maximum(dd.hi[aside].min(axis=1), 0.0)).max()
             acc["bound"] = max(acc["bound"], float(longest))
         floor = _floor(dd, min_width)
@@ -284,7 +294,6 @@ def _roots(land: BoxLandscape, lo, hi, k_lo, k_hi, acc: dict, steps: int = 40):
 
 
 def point_derivatives(land: BoxLandscape, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """grad V and its Hessian at points (R, n), from the enclosures at each point."""
-    point = Interval(x)
-    _, g, states = land.enclose(point)
-    return g.mid, land.hessian(point, states).mid
+    """grad V and its Hessian at points (R, n) in double precision (for Newton only: what is
+    proved comes from the enclosures)."""
+    return land.derivatives(x)

@@ -165,6 +165,44 @@ class TorusFramework:
             hi[rows] = np.maximum(hi[rows], h.hi.reshape(-1, m, m))
         return Interval(lo, hi)
 
+    def derivatives(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """grad V and its Hessian at points (R, n angles) in double precision, from the
+        generated numpy code (Newton's steps; each point's Hessian that of its taut set)."""
+        P = np.asarray(self.P)
+        first = self.full.numeric.first_order(self._numeric_pose(self.full, x), P)
+        dim, m, per = self.fw.dim, self.n, self.fw.dim + self.fw.dim * self.n
+        grad = np.zeros((len(x), m))
+        grad += np.stack([np.broadcast_to(v, (len(x),)) for v in first[len(self.links) * per:]],
+                         axis=1) if m else 0.0  # fmt: skip
+        taut = np.ones((len(x), len(self.cables)), dtype=bool)
+        for i, link in enumerate(self.links):
+            block = [np.broadcast_to(v, (len(x),)) for v in first[i * per : (i + 1) * per]]
+            r, dr = np.stack(block[:dim], axis=1), np.stack(block[dim:], axis=1)
+            d = np.sqrt((r * r).sum(axis=1))
+            a = np.einsum("nc,ncj->nj", r, dr.reshape(len(x), dim, m))
+            w = np.full(len(x), link.k) if link.L0 is None else link.k * (1 - link.L0 / d)
+            if link.cable and link.L0 is not None:
+                on = d > link.L0
+                taut[:, self.cables.index(link.name)] = on
+                w = np.where(on, w, 0.0)
+            grad += w[:, None] * a
+        hess = np.zeros((len(x), m, m))
+        for taut_set, fs in self.hessian_sets:
+            want = np.array([c in taut_set for c in self.cables], dtype=bool)
+            rows = np.flatnonzero((taut == want).all(axis=1))
+            if len(rows):
+                h = fs.numeric.hessian(self._numeric_pose(fs, x[rows]), P)
+                hess[rows] = np.stack([np.broadcast_to(v, (len(rows),)) for v in h],
+                                      axis=1).reshape(-1, m, m)  # fmt: skip
+        return grad, hess
+
+    def _numeric_pose(self, fs: FrameworkSystem, x: np.ndarray) -> np.ndarray:
+        index = {v: j for j, v in enumerate(fs.ps.variables)}
+        X = np.zeros((len(x), len(fs.ps.variables)))
+        for j, b in enumerate(self.bodies):
+            X[:, index[f"s_{b}"]], X[:, index[f"c_{b}"]] = np.sin(x[:, j]), np.cos(x[:, j])
+        return X
+
     def endpoints(self, roots: np.ndarray) -> dict[tuple[str, ...], Endpoints]:
         """The critical points (R, n angles) as endpoints of their taut sets' systems."""
         point = Interval(roots)

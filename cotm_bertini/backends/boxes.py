@@ -14,9 +14,10 @@ is not smooth at length 0. Each box is
 - or split along its wide sides; a box that reaches the smallest width undecided is listed.
 
 A box with one critical point gives a root: Newton in double precision from the middle of
-K(X) n X, in double precision. Boxes are rows of two (B, n) arrays, lo and hi, in radians (a
-box listed in a result is one row lo_1..lo_n, hi_1..hi_n); the domain is [offset, offset + 2 pi]^n, with an offset that is no simple fraction
-of pi so that no symmetric pose falls on the edges of the first grid or of its halvings.
+K(X) n X. Boxes are rows of two (B, n) arrays, lo and hi, in radians (a box listed in a result
+is one row lo_1..lo_n, hi_1..hi_n); the domain is [offset, offset + 2 pi]^n, with an offset that
+is no simple fraction of pi so that no symmetric pose falls on the edges of the first grid or of
+its halvings.
 """
 
 from __future__ import annotations
@@ -33,8 +34,9 @@ from ..progress import Progress
 
 TWO_PI = 2 * math.pi
 OFFSET = -0.0123456789  # radians: the domain's lower corner (see the module docstring)
-BATCH = 4096
-KRAWCZYK_WIDTH = 0.2  # radians: wider boxes are split, not tested (the test rarely decides them)  # boxes a step: large enough that numpy's loops, not Python, set the pace
+KRAWCZYK_WIDTH = 0.2  # radians: wider boxes are split, not tested (the test rarely decides them)
+BATCH = 4096  # boxes a step: large enough that numpy's loops, not Python, set the pace
+KRAWCZYK_WIDTH = 0.2  # radians: wider boxes are split, not tested (the test rarely decides them)
 SHORT = 1e-3  # length units: springs shorter than this are set aside (V has a cone point at 0)
 MIN_WIDTH = 1e-4  # radians: the smallest box away from a critical point
 ROOT_FLOOR = 1e-10  # radians: boxes are not split below this, whatever a spring's length
@@ -136,8 +138,8 @@ def search(
     undec = _rows(undecided, n)
     return BoxSearch(
         np.array(roots).reshape(-1, n), np.array(root_boxes).reshape(-1, 2 * n), acc["failed"],
-        acc["aside"], acc["bound"], _rows(acc["aside_boxes"], n), undec, acc["boxes"], time.perf_counter() - t0,
-        acc["shortest"], budget,
+        acc["aside"], acc["bound"], _rows(acc["aside_boxes"], n), undec, acc["boxes"],
+        time.perf_counter() - t0, acc["shortest"], budget,
     )  # fmt: skip
 
 

@@ -34,7 +34,6 @@ from ..progress import Progress
 
 TWO_PI = 2 * math.pi
 OFFSET = -0.0123456789  # radians: the domain's lower corner (see the module docstring)
-KRAWCZYK_WIDTH = 0.2  # radians: wider boxes are split, not tested (the test rarely decides them)
 BATCH = 4096  # boxes a step: large enough that numpy's loops, not Python, set the pace
 KRAWCZYK_WIDTH = 0.2  # radians: wider boxes are split, not tested (the test rarely decides them)
 SHORT = 1e-3  # length units: springs shorter than this are set aside (V has a cone point at 0)

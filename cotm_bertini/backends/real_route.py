@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, lru_cache
 
 import numpy as np
 
@@ -30,6 +30,7 @@ from ..model.framework.spec import Framework
 from ..model.framework.structure import layout
 from ..model.framework.units import normalized_slots
 from ..model.intervals import Interval, stack
+from .boxes import MIN_WIDTH, SHORT, BoxSearch, search
 from .endpoints import Endpoints
 
 TAUT, SLACK, EITHER = 1, 0, 2
@@ -243,6 +244,16 @@ class TorusFramework:
             np.zeros(count), nan, nan, nan, np.ones(count, dtype=np.int64),
             np.zeros(count, dtype=bool),
         )  # fmt: skip
+
+
+@lru_cache(maxsize=128)
+def real_equilibria(fw: Framework) -> tuple[dict[tuple[str, ...], Endpoints], BoxSearch]:
+    """Every real critical point of V (the search's default settings), as endpoints by taut set
+    (keys sorted, as FrameworkSystem.taut), with the search's record; kept for the last
+    frameworks asked for, since fold seeds of every curve system share their crossings."""
+    land = TorusFramework(fw)
+    found = search(land, SHORT, MIN_WIDTH, label=f"real search of {fw.name}")
+    return {tuple(sorted(k)): v for k, v in land.endpoints(found.roots).items()}, found
 
 
 def _sum(items) -> Interval:

@@ -24,6 +24,7 @@ from ..model.framework.folds import CurveSystem
 from ..model.framework.spec import Framework
 from ..model.framework.units import normalized_slots
 from ..model.polynomial import PolySystem
+from ..point import framework_route
 from ..progress import Progress
 from ..settings import Settings, Tolerances
 from .curve_trace import Traced, Window, newton, remembered, trace, turning_point
@@ -93,6 +94,8 @@ def _generic_sets(task) -> None:
     from ..backends.generic import evidence_sets
 
     fw, cs, settings = task
+    if framework_route(fw, settings) == "real":
+        return  # the crossings' equilibria come from the real route: no generic set
     fs = framework_system(fw.at_defaults(), cs.taut)
     slots = normalized_slots(fw.at_defaults())
     centre = {n: slots[n] for n in fs.ps.parameters}
@@ -106,6 +109,8 @@ def _solve_line(task) -> dict:
 
     fw, cs, spec, ts, names, settings = task
     sx, sy = cs.scales
+    if framework_route(fw, settings) == "real":
+        return _real_line(task)
     centre = normalized_slots(fw.at_defaults())
     out, warm = {}, None
     for t in ts:
@@ -117,6 +122,26 @@ def _solve_line(task) -> dict:
         hs = solve_parameters(fs.ps, normalized_slots(fwp), centre, settings,
                               variable_groups(fs), warm)  # fmt: skip
         out[mx, my], warm = (real_points(hs), int(hs.info["lost"])), hs.warm
+    return out
+
+
+def _real_line(task) -> dict:
+    """`_solve_line` by the real route: each crossing's real equilibria of the taut set (those
+    consistent with its cable states: a branch that becomes consistent between two crossings
+    enters through a cable switch), and as 'lost' the boxes its search left undecided."""
+    from ..backends.real_route import real_equilibria
+
+    fw, cs, spec, ts, names, _ = task
+    sx, sy = cs.scales
+    out = {}
+    for t in ts:
+        mx, my = _key(spec, t)
+        groups, found = real_equilibria(fw.replace(**{names[0]: mx * sx, names[1]: my * sy}))
+        eps = groups.get(tuple(sorted(cs.taut)))
+        if eps is not None and tuple(eps.variables) != cs.variables:
+            raise AssertionError("the fold system's unknowns differ from the equilibria's")
+        pts = eps.points.real if eps is not None else np.zeros((0, len(cs.variables)))
+        out[mx, my] = (pts, len(found.undecided))
     return out
 
 

@@ -1,0 +1,187 @@
+"""A spatial rigid body on a ball joint (issue 39, item 1): each pose is the quaternion q and -q,
+reached by paths of their own, and the table must list it once. tests/fixtures/tee_mast.toml (a
+T-shaped mast, two crossbar springs of zero free length, a tip spring with a free length, a tip
+load) against a reference that shares no code with the package: V(R) on SO(3) written here in
+plain numpy from the file (read with tomllib), its critical points found by Newton in the
+rotation's tangent space (R <- R exp([w]x)) from random rotations and deduplicated as rotation
+matrices, each classified by the eigenvalues of its Hessian in those coordinates."""
+
+from __future__ import annotations
+
+import json
+import tomllib
+from functools import cache
+
+import numpy as np
+import pytest
+from conftest import ROOT, run_cli
+
+import cotm_bertini as cb
+
+FIXTURE = ROOT / "tests" / "fixtures" / "tee_mast.toml"
+SAME = 1e-6  # two rotations closer than this (max entry) are one
+STARTS = 1500
+
+
+def _rotation(q: np.ndarray) -> np.ndarray:
+    """Rotation matrices (n, 3, 3) of quaternions (n, 4) (w, x, y, z), normalised first."""
+    w, x, y, z = (q / np.linalg.norm(q, axis=1, keepdims=True)).T
+    return np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
+        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
+    ], -2)  # fmt: skip
+
+
+def _hat(w: np.ndarray) -> np.ndarray:
+    """[w]x (n, 3, 3): [w]x v = w x v."""
+    z = np.zeros(len(w))
+    return np.stack([
+        np.stack([z, -w[:, 2], w[:, 1]], -1),
+        np.stack([w[:, 2], z, -w[:, 0]], -1),
+        np.stack([-w[:, 1], w[:, 0], z], -1),
+    ], -2)  # fmt: skip
+
+
+def _exp(w: np.ndarray) -> np.ndarray:
+    """exp([w]x) by Rodrigues' formula (n, 3, 3)."""
+    t = np.linalg.norm(w, axis=1)[:, None, None]
+    K = _hat(w)
+    small = t < 1e-12
+    a = np.where(small, 1.0, np.sin(t) / np.where(small, 1.0, t))
+    b = np.where(small, 0.5, (1 - np.cos(t)) / np.where(small, 1.0, t) ** 2)
+    return np.eye(3) + a * K + b * K @ K
+
+
+@cache
+def _mast() -> dict:
+    """The fixture's elements as numbers: springs (body point, ground point, k, L0), the load."""
+    data = tomllib.loads(FIXTURE.read_text())
+    p = data["parameters"]
+
+    def num(v):
+        return float(p[v]) if isinstance(v, str) else float(v)
+
+    ground = {n: np.array(v, float) for n, v in data["ground"].items()}
+    body = {n: np.array(v, float) for n, v in data["bodies"]["mast"].items()}
+    springs = [(body[s["a"].split(".")[1]], ground[s["b"].split(".")[1]], num(s["k"]),
+                num(s["L0"])) for s in data["springs"]]  # fmt: skip
+    (load,) = data["loads"]
+    return {"springs": springs, "load": (body[load["point"].split(".")[1]],
+                                         np.array([num(f) for f in load["force"]]))}  # fmt: skip
+
+
+def energy(R: np.ndarray) -> np.ndarray:
+    """V(R) = sum k/2 (|R p - a| - L0)^2 - F . R t, per rotation (n, 3, 3)."""
+    m = _mast()
+    V = np.zeros(len(R))
+    for p, a, k, L0 in m["springs"]:
+        V += k / 2 * (np.linalg.norm(R @ p - a, axis=1) - L0) ** 2
+    t, F = m["load"]
+    return V - (R @ t) @ F
+
+
+def gradient(R: np.ndarray) -> np.ndarray:
+    """dV/dw of V(R exp([w]x)) at w = 0 (n, 3): d(R p)/dw = -R [p]x."""
+    m = _mast()
+    g = np.zeros((len(R), 3))
+    for p, a, k, L0 in m["springs"]:
+        r = R @ p - a
+        d = np.linalg.norm(r, axis=1, keepdims=True)
+        g += np.einsum("ni,nij->nj", k * (1 - L0 / d) * r, -R @ _hat(p[None])[0])
+    t, F = m["load"]
+    return g - np.einsum("i,nij->nj", F, -R @ _hat(t[None])[0])
+
+
+def hessian(R: np.ndarray, h: float = 1e-5) -> np.ndarray:
+    """d^2 V / dw^2 at w = 0 (n, 3, 3), central differences of `gradient`; symmetric at a
+    critical point (where the choice of the exponential chart does not matter)."""
+    cols = []
+    for j in range(3):
+        e = np.zeros((len(R), 3))
+        e[:, j] = h
+        cols.append((gradient(R @ _exp(e)) - gradient(R @ _exp(-e))) / (2 * h))
+    H = np.stack(cols, axis=-1)
+    return (H + np.swapaxes(H, 1, 2)) / 2
+
+
+@cache
+def critical_points(seed: int = 7) -> tuple[np.ndarray, np.ndarray]:
+    """(rotations (m, 3, 3), Hessian indices (m,)) of every critical point of V that Newton
+    reaches from STARTS random rotations (steps capped at 0.5 rad), one per rotation."""
+    rng = np.random.default_rng(seed)
+    R = _rotation(rng.normal(size=(STARTS, 4)))
+    for _ in range(60):
+        H, g = hessian(R), gradient(R)
+        step = -np.linalg.solve(H + 1e-14 * np.eye(3), g[..., None])[..., 0]
+        norm = np.linalg.norm(step, axis=1, keepdims=True)
+        R = R @ _exp(step * np.minimum(1.0, 0.5 / np.maximum(norm, 1e-300)))
+    done = np.linalg.norm(gradient(R), axis=1) < 1e-10
+    found: list[np.ndarray] = []
+    for r in R[done]:
+        if all(np.abs(r - f).max() > SAME for f in found):
+            found.append(r)
+    rots = np.array(found)
+    eig = np.linalg.eigvalsh(hessian(rots))
+    assert (np.abs(eig) > 1e-6).all(), "a degenerate critical point: choose other numbers"
+    return rots, (eig < 0).sum(axis=1)
+
+
+def _row_rotations(table) -> np.ndarray:
+    return _rotation(table[["mast.qw", "mast.qx", "mast.qy", "mast.qz"]].to_numpy(float))
+
+
+def test_the_reference_is_complete():
+    """The reference's own check: its Morse sum is chi(SO(3)) = 0 with a minimum, and a second
+    seed finds the same critical points."""
+    rots, index = critical_points()
+    assert (index == 0).sum() >= 1 and ((-1) ** index).sum() == 0
+    other, _ = critical_points(seed=11)
+    assert len(other) == len(rots)
+    assert all(np.abs(rots - r).max(axis=(1, 2)).min() < SAME for r in other)
+
+
+@pytest.fixture(scope="module")
+def solved():
+    return cb.solve(cb.Framework.from_toml(FIXTURE))
+
+
+def test_each_pose_once_and_every_critical_point_found(solved):
+    """Physical rows = the reference's critical points, one row each (not one per sign of q),
+    kinds and energies alike; no two real rows are one rotation."""
+    rots, index = critical_points()
+    phys = solved.physical
+    assert len(phys) == len(rots) and len(solved.stable) == int((index == 0).sum())
+    kinds = np.where(index == 0, "min", np.where(index == 3, "max", "saddle"))
+    R = _row_rotations(phys)
+    matched = []
+    for r, kind, V in zip(R, phys["kind"], phys["energy"], strict=True):
+        gap = np.abs(rots - r).max(axis=(1, 2))
+        j = int(np.argmin(gap))
+        assert gap[j] < 1e-7 and kind == kinds[j]
+        assert V == pytest.approx(energy(rots[j : j + 1])[0], abs=1e-9)
+        matched.append(j)
+    assert sorted(matched) == list(range(len(rots)))
+    real = solved.table[solved.table["is_real"].astype(bool)]
+    Rr = _row_rotations(real)
+    gaps = np.abs(Rr[:, None] - Rr[None]).max(axis=(2, 3)) + np.eye(len(Rr))
+    assert gaps.min() > SAME, "two real rows are one rotation (q and -q)"
+    assert solved.counts["physical"] == len(rots)
+
+
+def test_the_certificate_counts_each_pose_once(solved):
+    rots, _ = critical_points()
+    cert = cb.certify(solved)
+    assert cert.status == "rows proved", cert.statement
+    assert f"; {len(rots)} physical (consistency and stability proved)" in cert.statement
+
+
+def test_cli_solve_counts_each_pose_once(tmp_path):
+    rots, index = critical_points()
+    r = run_cli(
+        "solve", "--framework", str(FIXTURE), "--out", str(tmp_path), "--no-plots", "--no-cache"
+    )
+    assert r.returncode == 0, r.stderr
+    assert f"{len(rots)} physical, {int((index == 0).sum())} stable" in r.stdout
+    counts = json.loads(next(tmp_path.glob("*/run.json")).read_text())["counts"]
+    assert counts["physical"] == len(rots) and counts["stable"] == int((index == 0).sum())

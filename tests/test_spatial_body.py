@@ -54,10 +54,11 @@ def _exp(w: np.ndarray) -> np.ndarray:
 
 
 @cache
-def _mast() -> dict:
-    """The fixture's elements as numbers: springs (body point, ground point, k, L0), the load."""
+def _mast(fx: float | None = None) -> dict:
+    """The fixture's elements as numbers: springs (body point, ground point, k, L0), the load
+    (with `fx`, that parameter set to it)."""
     data = tomllib.loads(FIXTURE.read_text())
-    p = data["parameters"]
+    p = {**data["parameters"], **({} if fx is None else {"fx": fx})}
 
     def num(v):
         return float(p[v]) if isinstance(v, str) else float(v)
@@ -71,9 +72,9 @@ def _mast() -> dict:
                                          np.array([num(f) for f in load["force"]]))}  # fmt: skip
 
 
-def energy(R: np.ndarray) -> np.ndarray:
+def energy(R: np.ndarray, fx: float | None = None) -> np.ndarray:
     """V(R) = sum k/2 (|R p - a| - L0)^2 - F . R t, per rotation (n, 3, 3)."""
-    m = _mast()
+    m = _mast(fx)
     V = np.zeros(len(R))
     for p, a, k, L0 in m["springs"]:
         V += k / 2 * (np.linalg.norm(R @ p - a, axis=1) - L0) ** 2
@@ -81,9 +82,9 @@ def energy(R: np.ndarray) -> np.ndarray:
     return V - (R @ t) @ F
 
 
-def gradient(R: np.ndarray) -> np.ndarray:
+def gradient(R: np.ndarray, fx: float | None = None) -> np.ndarray:
     """dV/dw of V(R exp([w]x)) at w = 0 (n, 3): d(R p)/dw = -R [p]x."""
-    m = _mast()
+    m = _mast(fx)
     g = np.zeros((len(R), 3))
     for p, a, k, L0 in m["springs"]:
         r = R @ p - a
@@ -93,36 +94,36 @@ def gradient(R: np.ndarray) -> np.ndarray:
     return g - np.einsum("i,nij->nj", F, -R @ _hat(t[None])[0])
 
 
-def hessian(R: np.ndarray, h: float = 1e-5) -> np.ndarray:
+def hessian(R: np.ndarray, fx: float | None = None, h: float = 1e-5) -> np.ndarray:
     """d^2 V / dw^2 at w = 0 (n, 3, 3), central differences of `gradient`; symmetric at a
     critical point (where the choice of the exponential chart does not matter)."""
     cols = []
     for j in range(3):
         e = np.zeros((len(R), 3))
         e[:, j] = h
-        cols.append((gradient(R @ _exp(e)) - gradient(R @ _exp(-e))) / (2 * h))
+        cols.append((gradient(R @ _exp(e), fx) - gradient(R @ _exp(-e), fx)) / (2 * h))
     H = np.stack(cols, axis=-1)
     return (H + np.swapaxes(H, 1, 2)) / 2
 
 
 @cache
-def critical_points(seed: int = 7) -> tuple[np.ndarray, np.ndarray]:
+def critical_points(seed: int = 7, fx: float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """(rotations (m, 3, 3), Hessian indices (m,)) of every critical point of V that Newton
     reaches from STARTS random rotations (steps capped at 0.5 rad), one per rotation."""
     rng = np.random.default_rng(seed)
     R = _rotation(rng.normal(size=(STARTS, 4)))
     for _ in range(60):
-        H, g = hessian(R), gradient(R)
+        H, g = hessian(R, fx), gradient(R, fx)
         step = -np.linalg.solve(H + 1e-14 * np.eye(3), g[..., None])[..., 0]
         norm = np.linalg.norm(step, axis=1, keepdims=True)
         R = R @ _exp(step * np.minimum(1.0, 0.5 / np.maximum(norm, 1e-300)))
-    done = np.linalg.norm(gradient(R), axis=1) < 1e-10
+    done = np.linalg.norm(gradient(R, fx), axis=1) < 1e-10
     found: list[np.ndarray] = []
     for r in R[done]:
         if all(np.abs(r - f).max() > SAME for f in found):
             found.append(r)
     rots = np.array(found)
-    eig = np.linalg.eigvalsh(hessian(rots))
+    eig = np.linalg.eigvalsh(hessian(rots, fx))
     assert (np.abs(eig) > 1e-6).all(), "a degenerate critical point: choose other numbers"
     return rots, (eig < 0).sum(axis=1)
 
@@ -185,3 +186,40 @@ def test_cli_solve_counts_each_pose_once(tmp_path):
     assert f"{len(rots)} physical, {int((index == 0).sum())} stable" in r.stdout
     counts = json.loads(next(tmp_path.glob("*/run.json")).read_text())["counts"]
     assert counts["physical"] == len(rots) and counts["stable"] == int((index == 0).sum())
+
+
+def test_a_sweep_counts_each_pose_once_and_keeps_its_branches():
+    """Every point of a sweep over the load goes through the same classification: its physical
+    rows are the reference's critical points at that load, one each; each physical branch
+    runs through every point though the shown sign of one saddle's q flips on the way (its qw
+    crosses 0 near fx = 0.95: the branches are joined by sign-free coordinates)."""
+    values = [0.0, 0.5, 0.9, 1.0, 1.5]
+    sw = cb.sweep(cb.Framework.from_toml(FIXTURE), "fx", values)
+    table = sw.table
+    phys = table[table["physical"].astype(bool)]
+    for fx in values:
+        rots, index = critical_points(fx=fx)
+        here = phys[np.isclose(phys["fx"], fx)]
+        assert len(here) == len(rots) and ((-1) ** index).sum() == 0
+        R = _row_rotations(here)
+        assert all(np.abs(rots - r).max(axis=(1, 2)).min() < 1e-7 for r in R)
+    branches = phys.groupby("branch")
+    assert len(branches) == len(critical_points()[0])
+    assert all(len(b) == len(values) and b["kind"].nunique() == 1 for _, b in branches)
+    # A branch's next row is, of the next point's physical rows, the nearest rotation.
+    for a, b in zip(values, values[1:], strict=False):
+        now, then = (phys[np.isclose(phys["fx"], v)].sort_values("branch") for v in (a, b))
+        gap = np.abs(_row_rotations(now)[:, None] - _row_rotations(then)[None]).max(axis=(2, 3))
+        assert (gap.argmin(axis=1) == np.arange(len(now))).all()
+
+
+def test_q_and_minus_q_are_one_pose_for_branch_matching():
+    """The sweeps' match coordinates of a row and of the same row with -q are equal."""
+    from cotm_bertini.continuation.framework import pose_coordinates
+
+    fw = cb.Framework.from_toml(FIXTURE)
+    table = cb.solve(fw).physical
+    twin = table.copy()
+    for c in "wxyz":
+        twin[f"mast.q{c}"] = -twin[f"mast.q{c}"]
+    assert np.abs(pose_coordinates(fw, table) - pose_coordinates(fw, twin)).max() < 1e-15

@@ -223,3 +223,38 @@ def test_q_and_minus_q_are_one_pose_for_branch_matching():
     for c in "wxyz":
         twin[f"mast.q{c}"] = -twin[f"mast.q{c}"]
     assert np.abs(pose_coordinates(fw, table) - pose_coordinates(fw, twin)).max() < 1e-15
+
+
+def test_each_bodys_sign_flips_on_its_own():
+    """Two spatial bodies: a root and its three sign copies (-q1, -q2, both; the other unknowns
+    unchanged, endpoints refined to 1e-13) are one row with the paths of all four, also where
+    qw is 0 but for rounding (a half turn, where a first-component sign rule would split
+    them); a root whose second body differs stays a row of its own."""
+    from types import SimpleNamespace
+
+    from cotm_bertini.analysis.classify import Merged
+    from cotm_bertini.analysis.framework_classify import merge_sign_twins, shown_quaternions
+    from cotm_bertini.settings import Tolerances
+
+    rng = np.random.default_rng(3)
+    names = ["d_s", *(f"q{c}_one" for c in "wxyz"), "w_s", *(f"q{c}_two" for c in "wxyz")]
+    fs = SimpleNamespace(ps=SimpleNamespace(variables=names))
+    half_turn = np.array([1e-17, 0.6, -0.48, 0.64])  # qw of a half turn, as rounding leaves it
+    q2 = rng.normal(size=4)
+    rows, other = [], np.array([1.3, 0.0, 0.0, 0.0, 0.0, 2.1, 0.0, 0.0, 0.0, 0.0])
+    for s1, s2 in ((1, 1), (-1, 1), (1, -1), (-1, -1)):
+        x = other.copy()
+        x[1:5] = s1 * half_turn + np.array([s1 * -2e-17, 0, 0, 0])  # the sign of qw differs
+        x[6:10] = s2 * q2 / np.linalg.norm(q2)
+        rows.append(x + 1e-13 * rng.normal(size=len(x)))
+    apart = rows[0].copy()
+    apart[6:10] = rng.normal(size=4) / 2
+    x = np.array([*rows, apart], dtype=complex)
+    n = len(x)
+    merged = Merged(x, np.ones(n, int), [str(i + 1) for i in range(n)], np.ones(n), np.ones(n),
+                    np.zeros(n, bool), np.full(n, 1e-26))  # fmt: skip
+    out = merge_sign_twins(fs, merged, Tolerances())
+    assert out.paths == ["1 2 3 4", "5"] and list(out.multiplicity) == [1, 1]
+    assert not out.singular.any()
+    shown = shown_quaternions(np.array(rows)[:, 1:5])
+    assert np.abs(shown - half_turn).max() < 1e-12  # each copy shown with one sign

@@ -177,6 +177,28 @@ def test_the_certificate_counts_each_pose_once(solved):
     assert f"; {len(rots)} physical (consistency and stability proved)" in cert.statement
 
 
+def test_a_pose_listed_twice_is_a_contradiction(solved):
+    """A table listing the minimum again with -q (as before issue 39) is not certified as two
+    equilibria: the certificate names the two rows as one pose."""
+    import pandas as pd
+
+    from cotm_bertini.analysis.certify.framework import certify_framework_table
+
+    table = solved.table.reset_index(drop=True)
+    twin = table[table["kind"] == "min"].copy()
+    first = int(twin["solution_id"].iloc[0])
+    for c in "wxyz":
+        twin[f"mast.q{c}"] = -twin[f"mast.q{c}"]
+    twin["solution_id"] = len(table) + 1
+    doubled = pd.concat([table, twin], ignore_index=True)
+    cert = certify_framework_table(solved.params, doubled)
+    assert cert.status == "contradiction", cert.statement
+    assert cert.contradictions == [
+        f"solutions {first} and {len(table) + 1} are proved at one pose (up to the sign of a "
+        "quaternion): one equilibrium listed twice"
+    ]
+
+
 def test_cli_solve_counts_each_pose_once(tmp_path):
     rots, index = critical_points()
     r = run_cli(

@@ -217,7 +217,8 @@ FRAMEWORK = {
     "BODY.x, BODY.y (BODY.z)": "world position of the origin of the body's own frame",
     "BODY.angle_deg": "planar: the body's rotation (deg) in [0, 360)",
     "BODY.qw, BODY.qx, BODY.qy, BODY.qz": "spatial: the body's rotation as a unit quaternion "
-    "(q and -q are one pose: the first non-zero component is positive)",
+    "(q and -q are one pose and one row: the sign shown makes the first component larger than "
+    "1e-9 in magnitude positive, so a half turn's qw of 1e-17 does not choose it)",
     "BODY.POINT.x, .y (.z)": "world coordinates of each named point of each body",
     "NODE.x, .y (.z)": "world coordinates of each node",
     "NAME.length": "spring or cable: its length (the signed length unknown where it has a free "
@@ -246,9 +247,10 @@ FRAMEWORK = {
     "max_imag": "the largest |Im| / (1 + |Re|) over the unknowns",
     "residual": "max |f_i| of the polynomial system at the refined point (framework's units)",
     "jacobian_condition": "condition number of the system's Jacobian at the refined point",
-    "multiplicity": "how many path endpoints reached this solution",
+    "multiplicity": "how many path endpoints reached this solution (a spatial body's q and -q "
+    "are reached by paths of their own: counted once)",
     "taut_set": "the cables taut in the polynomial system that gave this row",
-    "paths": "the path numbers that reached it",
+    "paths": "the path numbers that reached it (for a spatial body, those to q and to -q)",
 }
 
 FRAMEWORK_COUNTS = {

@@ -10,9 +10,11 @@ from ..model.framework.compiled import FrameworkSystem, slot_vector, variable_sc
 from ..model.framework.spec import Framework
 from ..model.framework.units import normalized_slots
 from ..settings import Tolerances
-from .classify import merge_endpoints, wrap_degrees
+from .classify import Merged, merge_endpoints, wrap_degrees
+from .cluster import cluster_endpoints
 
 _AXES = "xyz"
+QUATERNION_ZERO = 1e-9  # a quaternion component below this is 0 for the sign shown (q or -q)
 
 
 def framework_columns(
@@ -31,6 +33,7 @@ def framework_rows(fw, fs, endpoints: Endpoints, unit, tol: Tolerances = Toleran
     slots_n = normalized_slots(fw)
     system = fs.ps.instantiate([slots_n[n] for n in fs.ps.parameters])
     merged = merge_endpoints(system, endpoints.points, endpoints, tol, scaled=True)
+    merged = merge_sign_twins(fs, merged, tol)
     x = merged.x
     max_imag = (np.abs(x.imag) / (1.0 + np.abs(x.real))).max(axis=1) if len(x) else np.zeros(0)
     loose = np.minimum(10.0 * np.sqrt(np.maximum(merged.accuracy, 1e-16)), 1e-4)
@@ -64,6 +67,64 @@ def described(fw: Framework, fs: FrameworkSystem, x: np.ndarray, unit, tol) -> t
     cols.update(links)
     cols["energy"] = _energy(fw, pos, links)
     return cols, reason, borderline
+
+
+def quaternion_columns(fs: FrameworkSystem) -> list[np.ndarray]:
+    """The solver's columns (w, x, y, z) of each spatial body's quaternion."""
+    index = {v: j for j, v in enumerate(fs.ps.variables)}
+    bodies = dict.fromkeys(v.split("_", 1)[1] for v in index if v.startswith("qw_"))
+    return [np.array([index[f"q{c}_{b}"] for c in "wxyz"]) for b in bodies]
+
+
+def quaternion_products(q: np.ndarray) -> np.ndarray:
+    """(n, 10) products q_i q_j (i <= j) of quaternions q (n, 4), real or complex: the same
+    for q and -q, and equal only for q' = +-q (q q^T determines q up to its sign)."""
+    i, j = np.triu_indices(4)
+    return q[:, i] * q[:, j]
+
+
+def sign_free(x: np.ndarray, quaternions: list[np.ndarray]) -> np.ndarray:
+    """Solutions x (n, variables) with each body's quaternion replaced by its products
+    (`quaternion_products`): rows of one pose are equal whatever the sign of each body's q."""
+    body = np.zeros(x.shape[1], dtype=bool)
+    for cols in quaternions:
+        body[cols] = True
+    return np.hstack([x[:, ~body], *(quaternion_products(x[:, c]) for c in quaternions)])
+
+
+def merge_sign_twins(fs: FrameworkSystem, merged: Merged, tol: Tolerances) -> Merged:
+    """One row per pose: q and -q of a spatial body are one rotation, reached by paths of their
+    own, so the distinct roots come in sets of 2^bodies (each body's sign flips on its own).
+    Roots equal but for those signs are merged, compared by `sign_free` (no sign convention,
+    so no quaternion on a convention's boundary, e.g. qw = 0, is left doubled); the row keeps
+    the root's own multiplicity and condition, and the paths to every sign."""
+    quaternions = quaternion_columns(fs)
+    if not quaternions or len(merged.x) < 2:
+        return merged
+    key = sign_free(merged.x, quaternions)
+    labels = cluster_endpoints(key, merged.singular, merged.accuracy, tol.merge)
+    if np.array_equal(labels, np.arange(len(labels))):
+        return merged
+    groups = [np.flatnonzero(labels == g) for g in range(labels.max() + 1)]
+    first = np.array([m[0] for m in groups], dtype=int)
+    return Merged(
+        x=merged.x[first],
+        multiplicity=np.array([merged.multiplicity[m].max() for m in groups], dtype=int),
+        paths=[" ".join(merged.paths[i] for i in m) for m in groups],
+        condition_number=np.array([merged.condition_number[m].max() for m in groups]),
+        jacobian_condition=np.array([merged.jacobian_condition[m].min() for m in groups]),
+        singular=np.array([bool(merged.singular[m].any()) for m in groups], dtype=bool),
+        accuracy=np.array([merged.accuracy[m].max() for m in groups]),
+    )
+
+
+def shown_quaternions(q: np.ndarray) -> np.ndarray:
+    """Real quaternions q (n, 4) with the sign shown in the table: of q and -q, the one whose
+    first component larger than QUATERNION_ZERO in magnitude is positive (a component that is
+    0 but for rounding, e.g. qw of a half turn, does not choose the sign)."""
+    lead = (np.abs(q) > QUATERNION_ZERO).argmax(axis=1)
+    sign = np.sign(np.take_along_axis(q, lead[:, None], axis=1))
+    return q * np.where(sign < 0, -1.0, 1.0)
 
 
 def column_names(fw: Framework) -> list[str]:
@@ -102,10 +163,7 @@ def pose_columns(fw: Framework, fs: FrameworkSystem, var: dict, pos: dict) -> di
             angle = np.degrees(np.arctan2(var[f"s_{body}"].real, var[f"c_{body}"].real))
             cols[f"{body}.angle_deg"] = wrap_degrees(angle)
         else:
-            q = np.stack([var[f"q{c}_{body}"].real for c in "wxyz"], axis=1)
-            # q and -q are one pose: the first non-zero component is made positive.
-            lead = np.take_along_axis(q, (np.abs(q) > 1e-12).argmax(axis=1)[:, None], axis=1)
-            q = q * np.where(lead < 0, -1.0, 1.0)
+            q = shown_quaternions(np.stack([var[f"q{c}_{body}"].real for c in "wxyz"], axis=1))
             for k, c in enumerate("wxyz"):
                 cols[f"{body}.q{c}"] = q[:, k]
     for body, pts in fw.bodies:

@@ -98,9 +98,11 @@ def match_coordinates(fw: Framework, table) -> np.ndarray:
 
 
 def pose_coordinates(fw: Framework, table) -> np.ndarray:
-    """(rows, coordinates): (cos, sin) of every planar body's angle, quaternions, node
-    positions and link lengths in units of the framework's largest length (real parts: a
-    framework's table holds no imaginary parts)."""
+    """(rows, coordinates): (cos, sin) of every planar body's angle, the products q_i q_j of
+    every spatial body's quaternion (the same for q and -q: a pose whose shown sign flips
+    where qw crosses 0 stays on its branch), node positions and link lengths in units of the
+    framework's largest length (real parts: a framework's table holds no imaginary parts)."""
+    from ..analysis.framework_classify import quaternion_products
     from ..model.framework.units import units
 
     length = units(fw)[0]
@@ -109,8 +111,12 @@ def pose_coordinates(fw: Framework, table) -> np.ndarray:
         values = np.asarray(table[name], dtype=float)
         if name.endswith(".angle_deg"):
             cols += [np.cos(np.radians(values)), np.sin(np.radians(values))]
-        else:
-            cols.append(values / (1.0 if ".q" in name else length))
+        elif name.endswith(".qw"):
+            body = name[: -len(".qw")]
+            q = np.stack([np.asarray(table[f"{body}.q{c}"], float) for c in "wxyz"], axis=1)
+            cols += list(quaternion_products(q).T)
+        elif not name.endswith((".qx", ".qy", ".qz")):  # those went in with qw
+            cols.append(values / length)
     for link in fw.links:
         cols.append(np.asarray(table[f"{link.name}.length"], dtype=float) / length)
     return np.stack(cols, axis=1)

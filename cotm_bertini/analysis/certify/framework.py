@@ -29,6 +29,7 @@ from ...model.framework.compiled import FrameworkSystem, framework_system, varia
 from ...model.framework.spec import Framework
 from ...model.framework.structure import layout
 from ...model.framework.units import normalized_slots, slot_kind, units
+from ..framework_classify import quaternion_columns, sign_free
 from .inertia import reduced_kind
 from .mechanism import (
     ROOT_FAILED,
@@ -99,6 +100,8 @@ class _Rows:
     kinds: dict[int, str] = field(default_factory=dict)  # solution_id -> proved kind
     as_doubles: list[int] = field(default_factory=list)  # proved with the doubles exact only
     failed: dict[int, str] = field(default_factory=dict)  # solution_id -> the step that failed
+    boxes: dict[int, tuple] = field(default_factory=dict)  # row -> (real centre, half-widths)
+    one_pose: list[str] = field(default_factory=list)  # rows proved at one pose twice
 
 
 def _row_points(fw: Framework, fs: FrameworkSystem, table, rows: np.ndarray) -> tuple:
@@ -169,9 +172,31 @@ def certify_rows(fw: Framework, table, P: list, exact: list) -> _Rows:
                     if slots is exact:
                         out.as_doubles.append(int(table["solution_id"][row]))
                     X = [_real_ball(z, r) for z, r in zip(*proof, strict=True)]
+                    out.boxes[int(row)] = (np.array([float(z.real.mid()) for z in proof[0]]),
+                                           np.asarray(proof[1], dtype=float))  # fmt: skip
                     _judge(fw, fs, table, int(row), X, slots, out)
         for row in rows[~out.certified[rows]]:
             out.failed[int(table["solution_id"][row])] = ROOT_FAILED
+        out.one_pose += one_pose_twice(fs, table, rows[out.certified[rows]], out.boxes)
+    return out
+
+
+def one_pose_twice(fs: FrameworkSystem, table, rows: np.ndarray, boxes: dict) -> list[str]:
+    """Proved rows of one taut set whose boxes may hold one root up to the sign of each spatial
+    body's quaternion (q and -q are one pose: two rows would count one equilibrium twice),
+    compared by the sign-free products q_i q_j; a product moves by at most 2 r + r^2 when its
+    factors (|q_i| <= 1) move by r."""
+    quaternions = quaternion_columns(fs)
+    out = []
+    for n, a in enumerate(rows):
+        for b in rows[n + 1 :]:
+            (ca, ra), (cb, rb) = boxes[int(a)], boxes[int(b)]
+            r = float(ra.max() + rb.max())
+            gap = np.abs(sign_free(ca[None], quaternions) - sign_free(cb[None], quaternions))
+            if gap.max() <= 2 * r + r * r + 1e-12:
+                ids = [int(table["solution_id"][i]) for i in (a, b)]
+                out.append(f"solutions {ids[0]} and {ids[1]} are proved at one pose (up to the "
+                           "sign of a quaternion): one equilibrium listed twice")  # fmt: skip
     return out
 
 
@@ -430,7 +455,7 @@ def _row_contradictions(table, rows: _Rows) -> list[str]:
         elif verdict == "yes" and not physical[row]:
             out.append(f"solution {sid} is proved a real, consistent equilibrium, but the "
                        "table does not list it as physical")  # fmt: skip
-    return out + kind_differences(table, rows.kinds)
+    return out + kind_differences(table, rows.kinds) + rows.one_pose
 
 
 def _search_contradictions(fw, table, proof, known: list[Known], unproved: list[int]) -> list:

@@ -109,8 +109,10 @@ def main() -> None:
          {"first_solve_s": "{:.2f}", "later_solve_s": "{:.2f}", "first_over_later": "{:.2f}",
           "search_cpu_s": "{:.3f}", "us_per_box": "{:.1f}"})  # fmt: skip
     write_csv(frame, "real_route")
-    show("the paper's case 3: built-in model (Bertini) and cotm.toml (real route)",
-         pd.DataFrame([_paper_case3()]))
+    show(
+        "the paper's case 3: built-in model (Bertini) and cotm.toml (real route)",
+        pd.DataFrame([_paper_case3()]),
+    )
     if args.map:
         show("the X-module's 41 x 41 map", pd.DataFrame([_xmodule_map()]))
 

@@ -269,12 +269,13 @@ def framework_route(fw, settings: Settings) -> str:
 def _solve_real(fw, settings: Settings, tolerances: Tolerances, t: Timings) -> PointSolution:
     """Every real equilibrium of a framework on a circle or torus, by the branch and bound of
     backends.boxes over its body angles (backends.real_route), classified as the complex route's
-    endpoints are; the search's proof (or what it left undecided) is the completeness check."""
+    endpoints are; the search's proof (or what it left undecided) is the completeness check.
+    Boxes left undecided are searched for continua of equilibria (where V is constant along a
+    curve no box can be decided), traced and counted apart as on the complex route."""
     from .analysis.framework_checks import completeness, framework_counts, order_rows
-    from .analysis.framework_classify import framework_columns
+    from .analysis.framework_continua import absorb, continuum_record, find_continua
     from .backends.boxes import MIN_WIDTH, SHORT, search
-    from .backends.real_route import TorusFramework
-    from .model.framework.compiled import framework_system
+    from .backends.real_route import TorusFramework, critical_seeds
     from .model.framework.units import units
 
     unit = units(fw)
@@ -285,42 +286,92 @@ def _solve_real(fw, settings: Settings, tolerances: Tolerances, t: Timings) -> P
     with t.stage("solve"):
         found = search(land, SHORT, MIN_WIDTH, max_seconds=settings.timeout,
                        label=f"real search of {fw.name}")  # fmt: skip
-        groups = land.endpoints(found.roots)
+        seeds = critical_seeds(land, found.undecided)
+        groups = land.endpoints(np.vstack([found.roots, seeds]))
     report: dict = {" ".join(taut) or "none": {"excluded": True, "pruned": "bound smoothing",
                     "note": why.note()} for taut, why in pruned.items()}  # fmt: skip
-    parts = []
     with t.stage("classify"):
-        for taut in sets + [g for g in groups if g not in sets]:
-            eps = groups.get(taut)
-            report[" ".join(taut) or "none"] = {"route": "real", "roots": len(eps or ())}
-            if eps is not None:
-                parts.append(framework_columns(fw, framework_system(fw, taut), eps, unit,
-                                               tolerances))  # fmt: skip
-        table = order_rows(fw, parts)
-        checks = completeness(fw, table, report, near_cones=found.set_aside_boxes)
-    search_info = real_search_info(found, unit[0])
+        parts = _real_parts(fw, sets, groups, report, unit, tolerances)
+        continua = find_continua(fw, parts, unit, tolerances) if len(seeds) else []
+        absorb(parts, continua)
+        table = order_rows(fw, [p[0] for p in parts])
+        checks = completeness(fw, table, report, continua, near_cones=found.set_aside_boxes)
+    morse_bott = all(c.index is not None for c in continua)
+    search_info = real_search_info(found, unit[0], along_continua(land, found, continua),
+                                   morse_bott)  # fmt: skip
     warnings = tuple(search_info["warnings"] + checks["warnings"])
-    counts = {**framework_counts(table, report), "boxes": found.boxes}
+    counts = {**framework_counts(table, report, continua), "boxes": found.boxes}
     engine = {"flavour": "real", "path": "branch and bound (backends.boxes)", "version": ""}
     shape = {"taut_sets": list(report), "units": {"length": unit[0], "stiffness": unit[1]}}
     return PointSolution(
         fw, settings, table, None, counts, checks["morse"],
         STATUS_INCOMPLETE if warnings else STATUS_OK, warnings, engine, shape,
         {"taut_sets": report, "real_search": search_info}, "", t.stages, None,
+        tuple(continuum_record(c, n) for n, c in enumerate(continua, start=1)),
     )  # fmt: skip
 
 
-def real_search_info(found, length_unit: float) -> dict:
+def _real_parts(fw, sets: list, groups: dict, report: dict, unit, tolerances) -> list:
+    """Each taut set's rows from the real route's endpoints, (columns, system, solutions), with
+    its line of run.json's taut sets."""
+    from .analysis.framework_classify import framework_rows
+    from .model.framework.compiled import framework_system
+
+    parts = []
+    for taut in sets + [g for g in groups if g not in sets]:
+        eps = groups.get(taut)
+        report[" ".join(taut) or "none"] = {"route": "real", "roots": len(eps or ())}
+        if eps is not None:
+            fs = framework_system(fw, taut)
+            cols, x = framework_rows(fw, fs, eps, unit, tolerances)
+            parts.append((cols, fs, x))
+    return parts
+
+
+def along_continua(land, found, continua: list) -> int:
+    """How many of the search's undecided boxes lie along a traced continuum: within the
+    largest step between its traced points (in the body angles) of one of them."""
+    if not continua or not len(found.undecided):
+        return 0
+    n = land.n
+    mid = 0.5 * (found.undecided[:, :n] + found.undecided[:, n:])
+    near = np.zeros(len(mid), dtype=bool)
+    for c in continua:
+        pts = np.radians(np.stack([c.columns[f"{b}.angle_deg"] for b in land.bodies], axis=1))
+        gap = lambda a, b: np.abs((a - b + np.pi) % (2 * np.pi) - np.pi).max(axis=-1)  # noqa: E731
+        step = gap(pts[1:], pts[:-1]).max() if len(pts) > 1 else 0.0
+        near |= gap(mid[:, None, :], pts[None]).min(axis=1) <= step + 2 * MIN_WIDTH_RAD
+    return int(near.sum())
+
+
+MIN_WIDTH_RAD = 1e-4  # the real search's smallest box (backends.boxes.MIN_WIDTH)
+
+
+def real_search_info(found, length_unit: float, along: int = 0, morse_bott: bool = False) -> dict:
     """The real search's record for run.json: what was decided, set aside and left, and the
-    warnings a search that is not a proof gives."""
+    warnings a search that is not a proof gives (`along`: undecided boxes that lie along a
+    continuum of equilibria, which no box test can decide; `morse_bott`: every continuum has a
+    nondegenerate Hessian across it)."""
     warnings = []
-    if len(found.undecided):
+    if len(found.undecided) > along:
         warnings.append(
-            f"the real search left {len(found.undecided)} boxes undecided "
+            f"the real search left {len(found.undecided) - along} boxes undecided "
             f"({found.undecided_share:.3g} of the configuration space"
             f"{'; ' + found.budget_hit if found.budget_hit else ''}): equilibria may be missing "
             "there"
         )
+    notes = []
+    if along:
+        # Along a curve of critical points whose Hessian across it is nondegenerate (checked
+        # at every traced point: the continuum's Morse index) the Morse-Bott lemma leaves no
+        # other critical point near it; where that index is unknown the boxes stay a warning.
+        (notes if morse_bott else warnings).append(
+            f"{along} boxes of the real search (no wider than {MIN_WIDTH_RAD:g} rad) lie along "
+            "the continua of equilibria and stay undecided (V is constant along a continuum)"
+            + ("; no other equilibrium lies there by the Morse-Bott lemma (each continuum's "
+               "Hessian across it nondegenerate at its traced points)" if morse_bott else
+               ": no other equilibrium is proved absent within them")
+        )  # fmt: skip
     if found.newton_failed:
         warnings.append(f"{found.newton_failed} proved critical points not reached by Newton")
     return {
@@ -333,9 +384,11 @@ def real_search_info(found, length_unit: float) -> dict:
             None if not np.isfinite(found.shortest_length) else found.shortest_length * length_unit
         ),  # fmt: skip
         "undecided": len(found.undecided),
+        "undecided_along_continua": along,
         "undecided_share": found.undecided_share,
         "undecided_boxes_deg": np.degrees(found.undecided[:20]).round(6).tolist(),
         "warnings": warnings,
+        "notes": notes,
     }
 
 

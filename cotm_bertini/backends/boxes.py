@@ -38,6 +38,7 @@ BATCH = 4096  # boxes a step: large enough that numpy's loops, not Python, set t
 KRAWCZYK_WIDTH = 0.2  # radians: wider boxes are split, not tested (the test rarely decides them)
 SHORT = 1e-3  # length units: springs shorter than this are set aside (V has a cone point at 0)
 MIN_WIDTH = 1e-4  # radians: the smallest box away from a critical point
+NEAR_CONDITION = 1e10  # a critical point worth splitting below MIN_WIDTH for is no worse than this
 ROOT_FLOOR = 1e-10  # radians: boxes are not split below this, whatever a spring's length
 
 
@@ -198,9 +199,12 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, acc: dict)
 
 
 def _root_near(land: BoxLandscape, lo: np.ndarray, hi: np.ndarray, steps: int = 8) -> np.ndarray:
-    """Whether Newton from each box's middle ends within one box width of it (a critical point
-    there, badly conditioned or on an edge): such boxes are split further."""
+    """Whether Newton from each box's middle ends within one box width of it at an isolated
+    critical point (its Hessian's condition below NEAR_CONDITION: one on an edge or merely
+    badly conditioned): such boxes are split further. A point of a continuum (a singular
+    Hessian) is not: boxes along a curve of critical points stop at the smallest width."""
     x, w = 0.5 * (lo + hi), hi - lo
+    ok = np.ones(len(x), dtype=bool)
     for _ in range(steps):
         g, h = point_derivatives(land, x)
         with np.errstate(all="ignore"):
@@ -209,7 +213,9 @@ def _root_near(land: BoxLandscape, lo: np.ndarray, hi: np.ndarray, steps: int = 
             if ok.any():
                 dx[ok] = np.linalg.solve(h[ok], g[ok][..., None])[..., 0]
         x = x - np.where(ok[:, None], dx, 0.0)
-    return ((x >= lo - w) & (x <= hi + w)).all(axis=1) & np.isfinite(x).all(axis=1)
+    with np.errstate(all="ignore"):
+        ok &= np.linalg.cond(np.where(ok[:, None, None], h, np.eye(x.shape[1]))) < NEAR_CONDITION
+    return ok & ((x >= lo - w) & (x <= hi + w)).all(axis=1) & np.isfinite(x).all(axis=1)
 
 
 def _subset(states, mask: np.ndarray):

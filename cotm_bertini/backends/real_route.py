@@ -246,6 +246,22 @@ class TorusFramework:
         )  # fmt: skip
 
 
+def critical_seeds(land: TorusFramework, boxes: np.ndarray, most: int = 64) -> np.ndarray:
+    """Critical points near undecided boxes (lo_1..lo_n, hi_1..hi_n): Newton with a
+    least-squares step (the Hessian may be singular there: a continuum) from the middles of at
+    most `most` of them, spread over the list; the ends where |grad V| < 1e-10."""
+    n = land.n
+    if not len(boxes):
+        return np.zeros((0, n))
+    pick = boxes[np.unique(np.linspace(0, len(boxes) - 1, min(most, len(boxes))).astype(int))]
+    x = 0.5 * (pick[:, :n] + pick[:, n:])
+    for _ in range(30):
+        g, h = land.derivatives(x)
+        x = x - np.einsum("nij,nj->ni", np.linalg.pinv(h, rcond=1e-10), g)
+    g, _ = land.derivatives(x)
+    return x[np.isfinite(g).all(axis=1) & (np.abs(g).max(axis=1) < 1e-10)]
+
+
 @lru_cache(maxsize=128)
 def real_equilibria(fw: Framework) -> tuple[dict[tuple[str, ...], Endpoints], BoxSearch]:
     """Every real critical point of V (the search's default settings), as endpoints by taut set

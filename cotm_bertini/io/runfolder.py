@@ -70,17 +70,16 @@ def summary_head(record: dict, cached: bool = False) -> str:
     seconds = f"{record['timings'].get('solve', 0.0):.2f} s"
     if cached:
         seconds = f"(cached: {seconds} when solved on {record.get('solved', '?')})"
+    apart = f"; {continua} continua of equilibria apart" if continua else ""
     if engine["flavour"] == "real":
         return (
-            f"{c['distinct_solutions']} real solutions ({c['physical']} physical, "
-            f"{c['stable']} stable) by the real route: a branch and bound of {c['boxes']:,} boxes "
-            f"over the body angles; {seconds}"
+            f"{c['physical']} equilibria ({c['stable']} stable{apart}; {c['distinct_solutions']}"
+            f" real rows) by the real route: a branch and bound of {c['boxes']:,} boxes over the "
+            f"body angles; {seconds}"
         )
     return (
         f"{c['distinct_solutions']} distinct finite solutions "
-        f"({c['real']} real, {c['physical']} physical, {c['stable']} stable"
-        + (f"; {continua} continua of equilibria apart" if continua else "")
-        + ") from "
+        f"({c['real']} real, {c['physical']} physical, {c['stable']} stable" + apart + ") from "
         f"{c['finite_endpoints']} finite endpoints of {c['paths_tracked']} paths tracked"
         + (f" and {closed} computed in closed form" if closed else "")
         + f"; {engine['flavour']} ({engine['path']} {engine['version']}) {seconds}"

@@ -168,6 +168,7 @@ def sample_rate(ps, groups, seed: int, centre: dict) -> tuple[float, int]:
     finish; with none finished, the seconds spent (a lower bound)."""
     from bertini import nag_algorithm as na
 
+    from ..backends.crossings import solve as quiet_solve
     from ..backends.homotopy import GENERIC_MAX_STEPS, _bertini, generic_start, solver_errors
     from ..backends.path_progress import watched
     from ..backends.render import render_system
@@ -183,7 +184,7 @@ def sample_rate(ps, groups, seed: int, centre: dict) -> tuple[float, int]:
         solver = na.ZeroDimSolver(bertini.parse.system(render_system(system, groups)))
         solver.set(max_num_steps=GENERIC_MAX_STEPS, max_solve_wall_clock_duration=SAMPLE_SECONDS)
         with watched(solver, report):
-            solver.solve(show_progress=False)
+            quiet_solve(solver)
     done = int(report.done)
     return (time.perf_counter() - t0) / max(done, 1), done
 

@@ -71,8 +71,9 @@ class PointSolution:
 
 
 def path_counts(
-    endpoints: Endpoints, table: dict, paths_tracked: int | None, lost: int | None
-) -> dict:
+    endpoints: Endpoints, table: dict, paths_tracked: int | None, lost: int | None,
+    crossings: int = 0,
+) -> dict:  # fmt: skip
     """Path and solution counts, each meaning one thing (docs/columns.md, "counts"): closed-form
     endpoints apart from tracked ones; real = physical + negative_d + zero_length_real, and
     distinct_solutions = real + complex, complex counting zero_length_complex among its rows."""
@@ -86,6 +87,7 @@ def path_counts(
         "closed_form_endpoints": len(endpoints) - tracked_ends,
         "infinite_or_failed_paths": other,
         "lost_paths": lost,
+        "crossings_unresolved": crossings,
         "distinct_solutions": len(table["solution_id"]),
         "real": int(real.sum()),
         "complex": int((~real).sum()),
@@ -149,8 +151,7 @@ def solve_point(
     with t.stage("classify"):
         table = classify_columns(params, endpoints, tolerances)
         morse = morse_check(params, table)
-    counts = path_counts(endpoints, table, tracked, lost)
-    counts["crossings_unresolved"] = details.get("crossings_unresolved", 0)
+    counts = path_counts(endpoints, table, tracked, lost, details.get("crossings_unresolved", 0))
     status, warnings = _checks(
         morse, counts, details.get("homotopy", {}).get("generic_warnings", [])
     )

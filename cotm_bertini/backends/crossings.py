@@ -87,9 +87,10 @@ class _Filter:
             self.held = b""
 
 
-_LOCK = threading.Lock()
+_LOCK = threading.RLock()  # guards _STATE, between solves' threads and the pump's thread
 _DEPTH = [0]
-_STATE: dict = {}
+_STATE: dict = {}  # while capturing: saved (the real stderr), pump, read (bytes passed on)
+_SINK: dict = {}  # one file and one pump thread a process, made at the first capture
 
 
 @contextmanager
@@ -115,29 +116,33 @@ def _start() -> None:
     except (AttributeError, ValueError):
         pass
     try:
-        saved = os.dup(2)
+        saved = os.dup(2)  # each time: a test harness may have moved stderr in between
     except OSError:  # no stderr at all: nothing to keep clean
-        _STATE.clear()
         return
-    sink = tempfile.TemporaryFile()
-    os.dup2(sink.fileno(), 2)
-    stop = threading.Event()
-    pump = _Filter(saved)
-    thread = threading.Thread(target=_pass_on, args=(sink.fileno(), pump, stop), daemon=True)
-    _STATE.update(saved=saved, sink=sink, stop=stop, pump=pump, thread=thread, read=[0])
-    thread.start()
+    if _SINK.get("pid") != os.getpid():  # (a forked worker has its parent's: not its own)
+        _SINK.update(file=tempfile.TemporaryFile(), pid=os.getpid())
+        threading.Thread(target=_pass_on, daemon=True).start()
+    fd = _SINK["file"].fileno()
+    os.lseek(fd, 0, os.SEEK_SET)
+    os.ftruncate(fd, 0)
+    os.dup2(fd, 2)
+    _STATE.update(saved=saved, pump=_Filter(saved), read=0)
 
 
-def _pass_on(fd: int, pump: _Filter, stop: threading.Event) -> None:
-    while not stop.wait(POLL):
-        _drain(fd, pump)
+def _pass_on() -> None:
+    """The pump: what reached the file, passed on every POLL seconds while a capture runs."""
+    while True:
+        threading.Event().wait(POLL)
+        with _LOCK:
+            if _STATE:
+                _drain()
 
 
-def _drain(fd: int, pump: _Filter) -> None:
-    read = _STATE["read"]
-    while data := os.pread(fd, 1 << 16, read[0]):
-        read[0] += len(data)
-        pump.feed(data)
+def _drain() -> None:
+    fd = _SINK["file"].fileno()
+    while data := os.pread(fd, 1 << 16, _STATE["read"]):
+        _STATE["read"] += len(data)
+        _STATE["pump"].feed(data)
 
 
 def _stop() -> None:
@@ -147,11 +152,24 @@ def _stop() -> None:
         sys.stderr.flush()
     except (AttributeError, ValueError):
         pass
-    _STATE["stop"].set()
-    _STATE["thread"].join()
     os.dup2(_STATE["saved"], 2)  # nothing more goes to the file
-    _drain(_STATE["sink"].fileno(), _STATE["pump"])
+    _drain()
     _STATE["pump"].flush()
     os.close(_STATE["saved"])
-    _STATE["sink"].close()
     _STATE.clear()
+
+
+def _after_fork() -> None:
+    """A forked child starts with no capture: its stderr the real one, a lock of its own (the
+    parent's pump may have held it at the fork)."""
+    global _LOCK
+    if _STATE:
+        os.dup2(_STATE["saved"], 2)
+        os.close(_STATE["saved"])
+    _LOCK = threading.RLock()
+    _DEPTH[0] = 0
+    _STATE.clear()
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_after_fork)

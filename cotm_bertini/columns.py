@@ -195,6 +195,9 @@ COUNTS = {
     "roots where one spring with L0 > 0 has zero length (d = 0), one endpoint each",
     "infinite_or_failed_paths": "tracked paths that went to infinity or failed",
     "lost_paths": "failed paths that may have hidden a solution (the status is then incomplete)",
+    "crossings_unresolved": "paths that crossed another path where the solver could not part "
+    "them (Bertini's own warning: the affected solutions may be wrong); each is also a lost "
+    "path or in an incomplete generic set, and the status is then incomplete",
     "distinct_solutions": "rows of solutions.csv: every distinct finite solution, real or not "
     "(= real + complex)",
     "real": "real rows, physical or not (= physical + negative_d + zero_length_real)",
@@ -260,6 +263,8 @@ FRAMEWORK_COUNTS = {
     "finite_endpoints": "tracked paths that ended at a finite point",
     "infinite_or_failed_paths": "tracked paths that went to infinity or failed",
     "lost_paths": "failed paths that may have hidden a solution (the status is then incomplete)",
+    "crossings_unresolved": "paths, over every taut set, that crossed another path where the "
+    "solver could not part them (tracking to the point, and the generic sets it started from)",
     "distinct_solutions": "rows of solutions.csv",
     "real, physical, stable, singular": "rows that are so",
     "taut_sets_solved": "taut sets solved (cables always taut or never taut are not enumerated)",

@@ -17,6 +17,7 @@ import numpy as np
 
 from .analysis.classify import classify_columns
 from .analysis.morse import morse_check
+from .backends.crossings import in_solve
 from .backends.endpoints import Endpoints
 from .errors import ParameterError
 from .model.compiled import parametric_system
@@ -71,8 +72,9 @@ class PointSolution:
 
 
 def path_counts(
-    endpoints: Endpoints, table: dict, paths_tracked: int | None, lost: int | None
-) -> dict:
+    endpoints: Endpoints, table: dict, paths_tracked: int | None, lost: int | None,
+    crossings: int = 0,
+) -> dict:  # fmt: skip
     """Path and solution counts, each meaning one thing (docs/columns.md, "counts"): closed-form
     endpoints apart from tracked ones; real = physical + negative_d + zero_length_real, and
     distinct_solutions = real + complex, complex counting zero_length_complex among its rows."""
@@ -86,6 +88,7 @@ def path_counts(
         "closed_form_endpoints": len(endpoints) - tracked_ends,
         "infinite_or_failed_paths": other,
         "lost_paths": lost,
+        "crossings_unresolved": crossings,
         "distinct_solutions": len(table["solution_id"]),
         "real": int(real.sum()),
         "complex": int((~real).sum()),
@@ -112,6 +115,11 @@ def _checks(morse: dict, counts: dict, generic: list[str]) -> tuple[str, tuple[s
         warnings.append("; ".join(parts) + ": equilibria may be missing")
     if counts.get("lost_paths"):
         warnings.append(f"{counts['lost_paths']} paths lost: solutions may be missing")
+    if counts.get("crossings_unresolved"):
+        warnings.append(
+            f"{counts['crossings_unresolved']} paths crossed another path and the solver could "
+            "not part them: the affected solutions may be wrong"
+        )
     return (STATUS_INCOMPLETE if warnings else STATUS_OK), tuple(warnings)
 
 
@@ -144,7 +152,7 @@ def solve_point(
     with t.stage("classify"):
         table = classify_columns(params, endpoints, tolerances)
         morse = morse_check(params, table)
-    counts = path_counts(endpoints, table, tracked, lost)
+    counts = path_counts(endpoints, table, tracked, lost, details.get("crossings_unresolved", 0))
     status, warnings = _checks(
         morse, counts, details.get("homotopy", {}).get("generic_warnings", [])
     )
@@ -170,7 +178,8 @@ def _homotopy(params: Params, settings: Settings, ps, t: Timings, warm) -> tuple
         "path": "bertini module (in-process)",
         "version": hs.generic.bertini_version,
     }
-    details = {"homotopy": hs.info, "generic_set": hs.generic.summary()}
+    details = {"homotopy": hs.info, "generic_set": hs.generic.summary(),
+               "crossings_unresolved": in_solve(hs.info)}  # fmt: skip
     info = hs.info
     return hs.endpoints, info["tracked"], info["lost"], engine, details, hs.input_text, hs.warm
 
@@ -187,6 +196,7 @@ def _cli(params: Params, settings: Settings, system, folder: Path, title: str, t
         "output_layout": cs.output.layout,
         "bertini_seconds": cs.run.seconds,
         "bertini1_failed_paths_file": cs.output.failed_paths,
+        "crossings_unresolved": cs.run.crossings_unresolved,
     }
     if cs.attempts:
         details["attempts"] = cs.attempts

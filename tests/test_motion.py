@@ -329,6 +329,28 @@ def test_a_plan_between_zeeman_states_ends_in_the_goal(zeeman_bistable, order):
     assert cb.move(res, a, pl.path).ends_in == b  # the plan's table is a path as it is
 
 
+def test_a_plan_after_the_identical_map_reuses_it(zeeman_bistable, monkeypatch):
+    """Issue 39, item 6: a plan over the window and grid of a map made before takes that map
+    from the cache (no sweep, no fold curve: both raise here), and its run.json says so;
+    another grid is another map."""
+    from cotm_bertini.api import maps, sweeps
+
+    res, dm = zeeman_bistable
+    a, b = res.stable.solution_id.tolist()
+
+    def no(*args, **kwargs):
+        raise AssertionError("the map was made again")
+
+    monkeypatch.setattr(sweeps, "sweep", no)
+    monkeypatch.setattr(maps, "fold_points", no)
+    pl = cb.plan(res, a, b, WINDOW, points=ZEEMAN_POINTS)
+    assert pl.record["map_reused"] is True and pl.map.record["reused"] is True
+    assert pl.map.regions.equals(dm.regions) and pl.map.folds.equals(dm.folds)
+    assert pl.status == "ok"
+    with pytest.raises(AssertionError, match="made again"):
+        cb.plan(res, a, b, WINDOW, points=ZEEMAN_POINTS + 1)
+
+
 def test_a_window_inside_the_bistable_region_is_unreachable(zeeman_bistable):
     """A small window around the start where, by independent scans of V at its corners and
     centre, both stable states exist throughout: no plan, and the answer says so."""

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..backends.crossings import in_solve
 from ..model.framework.compiled import FrameworkSystem, framework_system, slot_vector
 from ..model.framework.spec import Framework
 from ..model.framework.structure import layout
@@ -71,6 +72,7 @@ def framework_counts(table: dict, report: dict, continua: list = ()) -> dict:
         "closed_form_endpoints": 0,
         "infinite_or_failed_paths": sum(r["tracked"] - r["finite"] for r in solved),
         "lost_paths": sum(r["lost"] for r in solved),
+        "crossings_unresolved": sum(in_solve(r) for r in solved),
         "generic_paths": sum(r["generic_paths"] for r in solved),
         "distinct_solutions": len(table["solution_id"]),
         "real": int(np.sum(table["is_real"])),
@@ -108,6 +110,11 @@ def completeness(
         warnings += [f"taut set {label}: {w}" for w in info.get("generic_warnings", [])]
         if info["lost"]:
             warnings.append(f"taut set {label}: {info['lost']} paths lost")
+        if info.get("crossings_unresolved"):  # (a generic set's: in its generic_warnings)
+            warnings.append(
+                f"taut set {label}: {info['crossings_unresolved']} of them crossed another "
+                "path and the solver could not part them: the affected solutions may be wrong"
+            )
         if info["generic_singular"]:
             warnings.append(
                 f"taut set {label}: {info['generic_singular']} singular endpoints at generic "

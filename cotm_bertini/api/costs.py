@@ -111,13 +111,7 @@ class Cost:
         if not self.paths_to_solve:
             return f"{text}; every generic set is in the cache already"
         if self.route == "monodromy":
-            todo = sum(len(self.seeds) - len(s.cached) for s in solved)
-            return (
-                f"{self._taut_sets()}, "
-                f"{todo} generic set{'s' * (todo != 1)} to find by monodromy (its paths follow "
-                f"the number of solutions, not known before; the total-degree route would "
-                f"track {per} paths per set): the progress lines measure the rate"
-            )
+            return self._monodromy(solved, per)
         from ..progress import duration
 
         also = "; and a monodromy set of the same seed to check it" * (self.route == "both")
@@ -125,6 +119,27 @@ class Cost:
             f"{text}; {self.paths_to_solve} still to solve, an estimated "
             f"{duration(self.estimate)} at {self.seconds_per_path:.2g} s a path "
             f"({self.rate_source}){also}"
+        )
+
+    def _monodromy(self, solved: list[SetCost], per: str) -> str:
+        """The headline by monodromy: no time (and why), and what the total-degree fallback
+        would take at a rate measured now, when one was."""
+        from ..progress import duration
+
+        todo = sum(len(self.seeds) - len(s.cached) for s in solved)
+        text = (
+            f"{self._taut_sets()}, {todo} generic set{'s' * (todo != 1)} to find by monodromy; "
+            "no time estimate: a monodromy search tracks paths until its trace test passes, "
+            "and how many it needs follows the number of solutions, which nothing counts "
+            "before the solve (the progress lines measure the rate as it runs)"
+        )
+        fallback = 2 * sum(s.paths for s in solved if len(s.cached) < len(self.seeds))
+        if not self.measured:
+            return f"{text}; the total-degree route would track {per} paths per set"
+        return (
+            f"{text}; should a trace test fail, the total-degree fallback tracks {fallback} "
+            f"paths (two seeds), an estimated {duration(fallback * self.seconds_per_path)} at "
+            f"{self.seconds_per_path:.2g} s a path ({self.rate_source})"
         )
 
     def _taut_sets(self) -> str:
@@ -176,6 +191,7 @@ def sample_rate(ps, groups, seed: int, centre: dict) -> tuple[float, int]:
     finish; with none finished, the seconds spent (a lower bound)."""
     from bertini import nag_algorithm as na
 
+    from ..backends.crossings import solve as quiet_solve
     from ..backends.homotopy import GENERIC_MAX_STEPS, _bertini, generic_start, solver_errors
     from ..backends.path_progress import watched
     from ..backends.render import render_system
@@ -191,7 +207,7 @@ def sample_rate(ps, groups, seed: int, centre: dict) -> tuple[float, int]:
         solver = na.ZeroDimSolver(bertini.parse.system(render_system(system, groups)))
         solver.set(max_num_steps=GENERIC_MAX_STEPS, max_solve_wall_clock_duration=SAMPLE_SECONDS)
         with watched(solver, report):
-            solver.solve(show_progress=False)
+            quiet_solve(solver)
     done = int(report.done)
     return (time.perf_counter() - t0) / max(done, 1), done
 
@@ -226,10 +242,12 @@ def cost(fw, settings: Settings | None = None, *, sample: bool | None = True) ->
     wanted = sample or (sample is None and pending * rate > SAMPLE_FROM)
     small = [k for k in todo if sets[k].paths <= SAMPLE_MAX_PATHS]
     probe = max(small, key=lambda k: sets[k].paths) if small else None
-    if big is not None and route != "monodromy" and wanted and probe is None:
+    # By monodromy only when asked (`params`): the rate then times the total-degree fallback.
+    wanted = wanted and (route != "monodromy" or sample is True)
+    if big is not None and wanted and probe is None:
         source += (f" (not sampled: every taut set has more than {SAMPLE_MAX_PATHS:,} paths, "
                    "and Bertini lays out every start point before its first path)")  # fmt: skip
-    elif big is not None and route != "monodromy" and wanted:
+    elif big is not None and wanted:
         ps, groups, centre = systems[probe]
         rate, n = sample_rate(ps, groups, seeds[0], centre)
         source = (

@@ -113,9 +113,13 @@ def design_map(
             model.replace(**{x: a, y: b})
     xs, ys = grid_values(*xr, points), grid_values(*yr, points)
     check_grid(model, x, tuple(map(float, xs)), y, tuple(map(float, ys)))  # every point too
+    check_workers(workers)  # before any process starts
+    key = _map_key(model, (x, xr), (y, yr), points, settings)
+    made = _made_before(model, key, (x, y))
+    if made is not None:
+        return made
     t0 = time.perf_counter()
     say(f"map: fold curves in the window {x} {xr[0]:g}..{xr[1]:g}, {y} {yr[0]:g}..{yr[1]:g}")
-    check_workers(workers)  # before any process starts
     job = (model, x, xr, y, yr, settings, workers)
     aside = _FoldsAside(job) if isinstance(model, Params) and workers > 1 else None
     if aside is None:
@@ -152,7 +156,57 @@ def design_map(
         record.update(explained(regions, folds, (x, y), sw.status))
         record["timings"]["check"] = time.perf_counter() - t1 - t_regions
     record["timings"]["total"] = time.perf_counter() - t0
+    record["reused"] = False
+    _keep(key, folds, regions, record)
     return DesignMap(model, folds, regions, record, (x, y))
+
+
+def _map_key(model, xa: tuple, ya: tuple, points: int, settings: Settings | None) -> str:
+    """What a map depends on (the model, its window and grid, the settings, this package's
+    code): two requests with one key make one map (the workers do not change it)."""
+    from ..io.cache import request_key
+
+    window = {"axes": [xa[0], ya[0]], "window": [list(xa[1]), list(ya[1])], "points": points}
+    settings = (settings or Settings()).as_dict()
+    return request_key({**model.key_fields(), "map": window}, settings, {})
+
+
+def _map_entry(key: str) -> Path:
+    from ..fs import cache_root
+
+    return cache_root() / "maps" / f"{key}.pickle"
+
+
+def _keep(key: str, folds: pd.DataFrame, regions: pd.DataFrame, record: dict) -> None:
+    """The map kept in the cache under `key` (its 2-D sweep stays where it was solved)."""
+    import pickle
+
+    from ..fs import atomic_write_bytes
+
+    entry = _map_entry(key)
+    entry.parent.mkdir(parents=True, exist_ok=True)
+    atomic_write_bytes(entry, pickle.dumps((folds, regions, record)))
+
+
+def _made_before(model, key: str, axes: tuple[str, str]) -> DesignMap | None:
+    """The map of an identical earlier request, said and marked (record["reused"]), when it
+    and its 2-D sweep are still in the cache; else None."""
+    import pickle
+
+    entry = _map_entry(key)
+    if not entry.is_file():
+        return None
+    try:
+        folds, regions, record = pickle.loads(entry.read_bytes())
+    except Exception:  # a damaged entry is made again, not trusted
+        entry.unlink(missing_ok=True)
+        return None
+    if not (Path(record["sweep_folder"]) / "sweep.csv").is_file():
+        return None
+    say(f"map: the same map (same model, window, grid and settings) was made before: reused "
+        f"(made in {duration(record['timings']['total'])}; no new solve)")  # fmt: skip
+    record = {**record, "reused": True, "command": sys.argv[:]}
+    return DesignMap(model, folds, regions, record, axes)
 
 
 def _timed_folds(job: tuple) -> tuple:

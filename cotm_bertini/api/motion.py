@@ -320,7 +320,8 @@ def plan(
         "snaps": found.snaps if found.waypoints else None, "travel": found.travel,
         "waypoints": len(found.waypoints), "states_expanded": found.expanded,
         "steps_simulated": found.steps_simulated, "states_not_in_map": found.unlisted,
-        "map_status": dm.status, "move_status": checked.status if checked else None,
+        "map_status": dm.status, "map_reused": bool(dm.record.get("reused")),
+        "move_status": checked.status if checked else None,
         "move_ends_in": checked.ends_in if checked else None,
         "timings": timings,
     }  # fmt: skip

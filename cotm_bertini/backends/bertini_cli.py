@@ -3,7 +3,9 @@
 The total-degree input file is rendered into an empty folder and Bertini runs there as a
 subprocess with a time limit; its output files stay in the folder and are parsed into endpoints.
 A crash, timeout or missing output is retried once with a new seed and tighter tracking; the
-failed attempt's files are kept in `failed-attempt-1/` and reported.
+failed attempt's files are kept in `failed-attempt-1/` and reported. So is a run after which
+Bertini warned that path crossings remained unresolved (crossings.py): the retry's crossings,
+if any are left, are counted (`CliSolve.crossings_unresolved`) and make the status incomplete.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ from pathlib import Path
 from ..errors import SolverError
 from ..model.polynomial import PolySystem
 from ..settings import Settings
+from .crossings import count_in
 from .endpoints import Endpoints
 from .engine import Engine, child_environment, find_engine
 from .parse import BertiniOutput, read_output
@@ -39,6 +42,11 @@ class SolverRun:
     stderr: str
     version: str
     paths_tracked: int | None  # as Bertini 1 prints it; None where not printed
+
+    @property
+    def crossings_unresolved(self) -> int:
+        """Path crossings Bertini warned it left unresolved (on stderr)."""
+        return count_in(self.stderr)
 
 
 @dataclass(frozen=True)
@@ -118,6 +126,11 @@ def solve_cli(
     t0 = time.perf_counter()
     try:
         run = run_bertini(text, folder, engine, settings.cli_timeout, settings.threads)
+        if run.crossings_unresolved:
+            raise SolverError(
+                f"Bertini left {run.crossings_unresolved} path crossings unresolved: the "
+                "affected solutions may be wrong"
+            )
     except SolverError as first:
         # One retry, as Bertini's own advice goes: a new random seed and tighter tracking.
         attempts.append(_set_aside(folder, 1, settings, first))
@@ -130,7 +143,8 @@ def solve_cli(
             raise SolverError(
                 f"{first} -- retried with seed {retry.seed} and tighter tolerances: {second}"
             ) from None
-        attempts.append({"attempt": 2, "settings": retry.bertini_config(), "ok": True})
+        attempts.append({"attempt": 2, "settings": retry.bertini_config(), "ok": True,
+                         "crossings_unresolved": run.crossings_unresolved})  # fmt: skip
     timings["bertini"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     out = read_output(folder)

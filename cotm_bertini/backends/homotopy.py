@@ -30,8 +30,11 @@ from ..params import Params
 from ..progress import duration, say
 from ..settings import Settings
 from ..versions import bertini2_version
+from . import crossings
+from .crossings import CROSSING
+from .crossings import solve as quiet_solve
 from .endpoints import Endpoints
-from .path_progress import expected, generic_report, remember, watched
+from .path_progress import PRIOR_SOURCE, expected, generic_report, remember, watched
 from .render import render_parameter_homotopy, render_system
 from .start_system import (
     gamma_homotopy_text,
@@ -43,6 +46,13 @@ DOUBLE_FINAL_TOLERANCE = 1e-8
 DOUBLE_MAX_STEPS = 2000
 GENERIC_MAX_STEPS = 20000  # steps a path of a framework's generic solve may take
 SECOND_START = 7919  # seed offset of the independent second generic set
+# A generic solve with crossings Bertini left unresolved is solved again with these (its
+# defaults: 1e-5, 1e-5, 1e-6), 100 times tighter, as its own warning advises.
+CROSSING_TOLERANCES = {
+    "tracking_tolerance": 1e-7,
+    "newton_before_endgame": 1e-7,
+    "newton_during_endgame": 1e-8,
+}
 ANNOUNCE_SECONDS = 2.0  # a generic solve expected to take longer is announced on stderr
 CHUNKS_PER_WORKER = 4  # a split generic solve sends this many chunks of paths per Dask worker
 BERTINI_MAX_NORM = 1e5  # Bertini's default security max norm (a larger norm counts as infinite)
@@ -74,7 +84,10 @@ def _bertini():
 
 def _code(m) -> str:
     """A path's outcome: the endgame's success code, or the pre-endgame one when the endgame
-    never started (a path that went to infinity before it reads NeverStarted there: lost)."""
+    never started (a path that went to infinity before it reads NeverStarted there: lost);
+    CROSSING for a path whose crossing of another Bertini left unresolved (crossings.py)."""
+    if crossings.flagged(m):
+        return CROSSING
     code = str(m.endgame_success_code).rsplit(".", 1)[-1]
     if code == "NeverStarted":
         before = str(m.pre_endgame_success_code).rsplit(".", 1)[-1]
@@ -254,6 +267,17 @@ def _announce(
         return
     where = f"once: kept in {stored} for every later solve" if stored else "not cached"
     how = f", split over the Dask workers at {scheduler}" if scheduler else ""
+    if source == PRIOR_SOURCE and groups:
+        # A framework's system with nothing measured on it yet: the prior (the paper's paths)
+        # is no estimate (a fallback set of 352 paths took ten times its 21 s): the first
+        # progress line, a few seconds in, gives the time left at its own paths' rate.
+        say(
+            f"cotm-bertini: solving the generic solution set of these equations for seed "
+            f"{seed} ({paths} paths{how}; {where}); no path of this system has been timed yet, "
+            "so the time is not estimated here: the progress lines give it, measured on "
+            "its first paths"
+        )
+        return
     roughly = f"{seconds:.0f} s" if seconds < 90 else duration(seconds)
     say(
         f"cotm-bertini: solving the generic solution set of these equations for seed {seed} "
@@ -308,19 +332,9 @@ def _bertini_solve(system, seed: int, groups, report=None) -> tuple[tuple, dict]
     """Every path of Bertini's own start system (multihomogeneous with `groups`, else total
     degree) in one ZeroDimSolver call: (codes, finite, singular, points), the route record.
     `report` (a progress.Progress) advances as each path finishes."""
-    bertini = _bertini()
-    from bertini import nag_algorithm as na
-
-    bertini.random.set_random_seed(seed)
     cpu = time.process_time()
-    solver = na.ZeroDimSolver(bertini.parse.system(render_system(system, groups)))
-    if groups:
-        # A framework's start system can send a few paths crawling for ever; a path cut short
-        # shows up as a count the second generic set (another seed) does not confirm.
-        solver.set(max_num_steps=GENERIC_MAX_STEPS)
-    with watched(solver, report) if report is not None else nullcontext():
-        solver.solve(show_progress=False)  # our report, not Bertini's own bar
-    meta, pts = solver.solution_metadata(), solver.all_solutions()
+    meta, pts = _zero_dim(system, seed, groups, report)
+    meta, pts, again = _part_crossings(system, seed, groups, meta, pts)
     points = _end_points(pts, len(system.variables))
     if groups:
         # Bertini orders the variables group by group; a merged group breaks our order.
@@ -337,8 +351,56 @@ def _bertini_solve(system, seed: int, groups, report=None) -> tuple[tuple, dict]
         "method": f"bertini {start} start (ZeroDimSolver), one call",
         "cpu_seconds": round(time.process_time() - cpu, 3),
         "failed_paths": _failed(ends[0]),
+        **again,
     }
     return ends, route
+
+
+def _part_crossings(system, seed: int, groups, meta, pts) -> tuple:
+    """(metadata, points, record): the solve as it was when no path's crossing was left
+    unresolved; else solved again from the same start at CROSSING_TOLERANCES, said, and
+    recorded (a set whose crossings remain is incomplete: its route says why)."""
+    crossed = sum(_code(m) == CROSSING for m in meta)
+    if not crossed:
+        return meta, pts, {}
+    # Bertini's own re-tracks (each at half the tolerance) did not part two paths.
+    say(
+        f"cotm-bertini: warning: {crossed} paths of the generic solve (seed {seed}) crossed "
+        "another path and Bertini could not part them (the affected solutions may be wrong); "
+        f"solving it again from the same start at tracking tolerances {CROSSING_TOLERANCES}"
+    )
+    meta, pts = _zero_dim(system, seed, groups, None, CROSSING_TOLERANCES)
+    left = sum(_code(m) == CROSSING for m in meta)
+    record = {"crossings_first_solve": crossed, "crossings_unresolved": left,
+              "crossings_solved_again_at": CROSSING_TOLERANCES}  # fmt: skip
+    if left:
+        why = (f"{left} paths crossed another path, unresolved even at tracking tolerances "
+               f"{CROSSING_TOLERANCES}: the affected solutions may be wrong")  # fmt: skip
+        say(f"cotm-bertini: warning: the generic set (seed {seed}) is incomplete: {why}")
+        record.update(complete=False, reason=why)
+    else:
+        say(f"cotm-bertini: the generic solve (seed {seed}) again: no crossing left")
+    return meta, pts, record
+
+
+def _zero_dim(system, seed: int, groups, report=None, tolerances: dict | None = None):
+    """One ZeroDimSolver call from Bertini's own start system for `seed`: (metadata, points).
+    `report` (a progress.Progress) advances as each path finishes; `tolerances`: tracking
+    settings other than Bertini's defaults."""
+    bertini = _bertini()
+    from bertini import nag_algorithm as na
+
+    bertini.random.set_random_seed(seed)
+    solver = na.ZeroDimSolver(bertini.parse.system(render_system(system, groups)))
+    if groups:
+        # A framework's start system can send a few paths crawling for ever; a path cut short
+        # shows up as a count the second generic set (another seed) does not confirm.
+        solver.set(max_num_steps=GENERIC_MAX_STEPS)
+    if tolerances:
+        solver.set(**tolerances)
+    with watched(solver, report) if report is not None else nullcontext():
+        quiet_solve(solver)  # our report, not Bertini's own bar
+    return solver.solution_metadata(), solver.all_solutions()
 
 
 def _split_solve(system, seed: int, groups, scheduler: str, report=None) -> tuple[tuple, dict]:
@@ -438,7 +500,7 @@ def _track_texts(texts: tuple[str, str], points: np.ndarray, mptype: str) -> dic
     else:
         solver.set(max_num_steps=GENERIC_MAX_STEPS)
     solver.set(num_threads=1)
-    solver.solve(show_progress=False)
+    quiet_solve(solver)
     meta, pts = solver.solution_metadata(), solver.all_solutions()
     return {
         "codes": [_code(m) for m in meta],
@@ -509,6 +571,7 @@ class TrackReport:
     infinite: int = 0
     retracked_adaptive: int = 0
     lost: int = 0
+    crossings_unresolved: int = 0  # of the lost: paths Bertini flagged (crossings.py)
     method: str = "parameter homotopy"
     seconds: float = 0.0
     notes: list[str] = field(default_factory=list)
@@ -573,7 +636,7 @@ def _track(
         hom, tgt = (bertini.parse.system(text) for text in texts)
         solver = na.HomotopySolver(hom, [gs.points[i] for i in idx], tgt, mptype=mptype)
         _configure(solver, settings, mptype, deadline, size)
-        solver.solve(show_progress=False)
+        quiet_solve(solver)
     if deadline is not None and time.perf_counter() > deadline:
         raise SolverError(f"the in-process solve timed out after {settings.timeout:g} s")
     return solver.solution_metadata(), solver.all_solutions()
@@ -615,6 +678,9 @@ def track(
     meta, pts = _track(texts, gs, list(range(n)), "double", settings, deadline, size)
     results = {i: (meta[i], pts[i]) for i in range(n)}
     redo = [i for i in range(n) if _code(meta[i]) != _SUCCESS or not meta[i].is_finite]
+    crossed = sum(_code(m) == CROSSING for m in meta)
+    if crossed:
+        rep.notes.append(f"{crossed} paths crossed another in double precision (Bertini's flag)")
     if _crossing(results, [i for i in range(n) if i not in redo]):
         redo = list(range(n))
         rep.notes.append("path crossing in double precision: all paths re-tracked")
@@ -638,6 +704,7 @@ def track(
             rep.infinite += 1
         else:
             rep.lost += 1
+            rep.crossings_unresolved += code == CROSSING
             rep.notes.append(f"path {i}: {code}")
     rep.finite = len(rows)
     rep.seconds = time.perf_counter() - t0
@@ -708,7 +775,7 @@ def ab_initio(
     with solver_errors(f"the total-degree solve at the target ({system.total_degree} paths)"):
         solver = na.ZeroDimSolver(bertini.parse.system(render_system(system)))
         _configure(solver, settings, "adaptive", None, max([1.0, *map(abs, values.values())]))
-        solver.solve(show_progress=False)
+        quiet_solve(solver)
         ends = list(zip(solver.solution_metadata(), solver.all_solutions(), strict=True))
     rows, rep = [], TrackReport(tracked=len(ends), method="ab initio")
     for i, (m, p) in enumerate(ends):
@@ -718,6 +785,7 @@ def ab_initio(
                 rows.append(endpoint_record(i, m, p))
         elif code not in INFINITE_CODES and (m.is_finite or code in NEVER_TRACKED):
             rep.lost += 1
+            rep.crossings_unresolved += code == CROSSING
             rep.notes.append(f"path {i}: {code}")
         else:
             rep.infinite += 1

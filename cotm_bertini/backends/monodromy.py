@@ -73,6 +73,7 @@ from ..fs import atomic_write_text
 from ..model.polynomial import ParametricSystem, PolySystem
 from ..progress import Progress, say
 from ..versions import bertini2_version
+from .crossings import solve as quiet_solve
 from .homotopy import (
     _SUCCESS,
     BERTINI_MAX_NORM,
@@ -350,7 +351,7 @@ def _bertini_paths(texts: tuple[str, str], points: np.ndarray, mptype: str, opti
     else:
         solver.set(max_num_steps=GENERIC_MAX_STEPS)
     solver.set(num_threads=1, **options)
-    solver.solve(show_progress=False)
+    quiet_solve(solver)
     meta = solver.solution_metadata()
     return {
         "codes": [_code(m) for m in meta],

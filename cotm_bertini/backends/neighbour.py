@@ -21,6 +21,7 @@ from ..model.pointsets import apart
 from ..model.polynomial import ParametricSystem
 from ..params import Params
 from ..settings import Settings
+from .crossings import solve as quiet_solve
 from .endpoints import Endpoints
 from .homotopy import (
     _SUCCESS,
@@ -157,7 +158,7 @@ def _run_homotopy(
         solver = na.HomotopySolver(hom, list(points), tgt, mptype=mptype)
         _configure(solver, settings, mptype, deadline, max([1.0, *map(abs, target.values())]))
         solver.set(**{k: bertini.multiprec.real_mp(v) for k, v in _CONTINUATION_STEPS.items()})
-        solver.solve(show_progress=False)
+        quiet_solve(solver)
     if deadline is not None and time.perf_counter() > deadline:
         raise SolverError(f"the in-process solve timed out after {settings.timeout:g} s")
     return solver.solution_metadata(), solver.all_solutions()

@@ -20,6 +20,7 @@ from ..progress import Progress
 # The one fixed prior left: case 3's 192 paths in ~12 s. Frameworks' paths cost up to ten times
 # more (the prism with a free-length diagonal: 0.59 s a path), hence the measured rates below.
 PRIOR_SECONDS_PER_PATH = 0.06
+PRIOR_SOURCE = "a fixed prior"  # the source of a first guess when nothing was measured
 _RATES: dict[tuple, tuple[float, str]] = {}  # (system, groups) -> (seconds a path, source)
 
 
@@ -36,7 +37,7 @@ def remember(ps, groups, seconds_per_path: float, source: str) -> None:
 
 def first_guess(ps, groups) -> tuple[float, str]:
     """(seconds a path, where that figure comes from) before a generic solve of `ps` starts."""
-    return _RATES.get(_key(ps, groups), (PRIOR_SECONDS_PER_PATH, "a fixed prior"))
+    return _RATES.get(_key(ps, groups), (PRIOR_SECONDS_PER_PATH, PRIOR_SOURCE))
 
 
 def path_count(ps, groups) -> int:

@@ -116,7 +116,8 @@ def from_generic(
         endpoints2, rep2 = track(ps, gs2, unit, settings, deadline)
         if rep2.lost == 0 and not rep.lost and rep2.finite == rep.finite:
             method += "; finite count confirmed from a second start"
-        elif rep2.lost == 0 and rep2.finite >= rep.finite:
+        elif rep2.lost == 0 and rep2.finite >= rep.finite and len(gs2.points) >= len(gs.points):
+            # (a second set with fewer roots, an incomplete one, proves nothing)
             endpoints, rep = endpoints2, rep2
             method = "parameter homotopy from a second start (the first lost paths)"
         else:

@@ -30,6 +30,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..progress import Progress
 from .framework import pose_coordinates, pose_names
 from .framework_switch import Switch, candidate_cable, locate_switch
 from .matching import point_keys, point_order
@@ -59,19 +60,25 @@ def framework_event_records(spec, table) -> list[dict]:
     rows = {k: np.flatnonzero(keys == k) for k, _ in order}
     part = [{n: np.asarray(table[n])[rows[k]] for n in table} for k, _ in order]
     events: list[dict] = []
-    for r in range(len(order) - 1):
-        (pa, pb), lo, past = (order[r][1], order[r + 1][1]), order[r][1], None
-        for _ in range(MAX_EVENTS):
-            if lo >= pb or _signature(part[r]) == _signature(part[r + 1]):
-                break
-            bracket = replace(_bisect(spec, lo, pb, past), start=(pa, pb))
-            switch = _switch(spec, bracket)
-            events.extend(_describe(spec, bracket, (part[r], part[r + 1]), switch))
-            # Two events between neighbouring points (their counts change twice): the rest of
-            # the interval is searched again from the bracket's upper end, its solve kept.
-            if _signature(bracket.above.columns) == _signature(part[r + 1]):
-                break
-            lo, past = bracket.hi, bracket.above
+    changed = [r for r in range(len(order) - 1) if _signature(part[r]) != _signature(part[r + 1])]
+    # Each bisection probe is a full solve (minutes on a large framework, more when a probe
+    # needs another generic set): said as it goes, after the sweep's last point.
+    with Progress("sweep: events refined", len(changed), "intervals", heartbeat=True) as report:
+        for r in changed:
+            (pa, pb), lo, past = (order[r][1], order[r + 1][1]), order[r][1], None
+            for _ in range(MAX_EVENTS):
+                if lo >= pb:
+                    break
+                bracket = replace(_bisect(spec, lo, pb, past), start=(pa, pb))
+                switch = _switch(spec, bracket)
+                events.extend(_describe(spec, bracket, (part[r], part[r + 1]), switch))
+                # Two events between neighbouring points (their counts change twice): the
+                # rest of the interval is searched again from the bracket's upper end, its
+                # solve kept.
+                if _signature(bracket.above.columns) == _signature(part[r + 1]):
+                    break
+                lo, past = bracket.hi, bracket.above
+            report.update(1, note=f"{len(events)} events")
     return sorted(events, key=lambda e: (e[param], e["kind"], e["branches"]))
 
 

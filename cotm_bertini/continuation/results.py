@@ -6,6 +6,7 @@ the folder's store holds them): no pandas, no CSV read back.
 
 from __future__ import annotations
 
+import json
 import time
 from collections import Counter
 from pathlib import Path
@@ -64,10 +65,13 @@ def finish_columns(
         tables = ("framework_sweep", "framework_events", "framework")
         if spec.param2 is None:
             table["branch"] = branch_ids(table, spec.param, match_coordinates(spec.model, table))
-            events = framework_event_records(spec, table)
+            events = _kept_events(folder, store, lambda: framework_event_records(spec, table))
     elif spec.param2 is None:
         table["branch"] = branch_ids(table, spec.param)
-        events = event_records(table, spec.param, Params(**spec.base), spec.settings)
+        base = Params(**spec.base)
+        events = _kept_events(
+            folder, store, lambda: event_records(table, spec.param, base, spec.settings)
+        )
     atomic_write_text(folder / "sweep.csv", _sweep_text(spec, store, table.get("branch")))
     atomic_write_text(folder / "events.csv", csv_text({n: [e[n] for e in events] for n in names}))
     atomic_write_text(folder / "columns.md", reference(*tables))
@@ -75,6 +79,36 @@ def finish_columns(
     record["timings"] = {"solve": stats["seconds"], "finish": time.perf_counter() - t0}
     write_json(folder / "run.json", record)
     return record, table
+
+
+EVENTS_KEPT = ".events.json"  # a sweep folder's refined events, with the points they are of
+
+
+def _kept_events(folder: Path, store: PointStore, refine) -> list[dict]:
+    """The events `refine()` finds (each a full solve per bisection probe: minutes on a large
+    framework), kept in the folder with the size of its points' store: a finished sweep run
+    again (resumed, say, to draw its page) reads them back instead of refining them again."""
+    from .._version import __version__
+
+    size = store.path.stat().st_size if store.path.is_file() else None
+    stamp = {"store_bytes": size, "points": len(store), "version": __version__}
+    kept = folder / EVENTS_KEPT
+    if size is not None and kept.is_file():
+        try:
+            data = json.loads(kept.read_text())
+            if data["stamp"] == stamp:
+                return data["events"]
+        except (ValueError, KeyError):
+            pass
+    events = refine()
+    if size is not None:
+        atomic_write_text(kept, json.dumps({"stamp": stamp, "events": events}, default=_plain))
+    return events
+
+
+def _plain(value):
+    """numpy scalars and arrays as JSON."""
+    return value.tolist() if hasattr(value, "tolist") else str(value)
 
 
 def _sweep_text(spec: SweepSpec, store: PointStore, branch: np.ndarray | None) -> str:

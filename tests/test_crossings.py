@@ -1,0 +1,136 @@
+"""A solver warning that a solution may be wrong is the run's warning (issue 39, item 4).
+
+Bertini prints "N path crossing(s) ... remained unresolved ...; the affected solutions may be
+wrong" from its C++ code on file descriptor 2 and flags the paths. Provoked here for real on a
+small system (Euler predictor, loose tracking, no tightening on its re-tracks), checked against
+an independent solve of the same system with Bertini's defaults (all 8 x 7 = 56 roots, the
+Bezout number, distinct): the flagged paths end at one point, so the provoked solve lacks a root.
+The package must keep Bertini's raw line off the console, read the flags, and carry them to the
+status and run.json.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+from conftest import ROOT, run_cli
+
+from cotm_bertini.backends import crossings
+
+SYSTEM = "variable_group x,y; function f1,f2; f1 = x^8 - 3*x*y + 1 - y^3; f2 = y^7 + x^2*y - 2 + x;"
+BERTINI_LINE = (
+    "warning: 4 path crossing(s) detected at the endgame boundary remained unresolved after 2 "
+    "re-track attempt(s); the affected solutions may be wrong.  Consider a higher-order "
+    "predictor or a tighter tracking tolerance.  See EndgameBoundaryMetadata().\n"
+)
+
+
+def _solver(sloppy: bool):
+    import bertini
+    from bertini import nag_algorithm as na
+    from bertini import tracking
+
+    bertini.random.set_random_seed(1)
+    solver = na.ZeroDimSolver(bertini.parse.system(SYSTEM), mptype="double")
+    solver.set(num_threads=1)
+    if sloppy:
+        solver.set(predictor=tracking.Predictor.Euler, tracking_tolerance=1e-1,
+                   newton_before_endgame=1e-1, midpath_decrease_tolerance_factor=1)  # fmt: skip
+    return solver
+
+
+def _points(solver) -> np.ndarray:
+    return np.array([[complex(z) for z in p] for p in solver.all_solutions()])
+
+
+def _distinct(pts: np.ndarray, tol: float = 1e-8) -> int:
+    kept: list[np.ndarray] = []
+    for p in pts:
+        if not any(np.abs(p - q).max() < tol for q in kept):
+            kept.append(p)
+    return len(kept)
+
+
+def test_a_provoked_crossing_is_read_from_the_flags_not_printed_raw(capfd):
+    """The provoked solve prints Bertini's line when run bare (the control); through
+    crossings.solve nothing of it reaches stderr, and exactly the flagged paths read as
+    CROSSING: they end at one point, and the solve has one root fewer than the 56 of an
+    independent default solve."""
+    from cotm_bertini.backends.homotopy import _code
+
+    _solver(True).solve(show_progress=False)
+    assert "path crossing(s)" in capfd.readouterr().err  # the provocation is real
+    sloppy, clean = _solver(True), _solver(False)
+    crossings.solve(sloppy)
+    crossings.solve(clean)
+    assert "path crossing(s)" not in capfd.readouterr().err
+    codes = [_code(m) for m in sloppy.solution_metadata()]
+    bad = [i for i, c in enumerate(codes) if c == crossings.CROSSING]
+    assert bad == [i for i, m in enumerate(sloppy.solution_metadata()) if m.crossing_unresolved]
+    assert len(bad) >= 2
+    pts, ref = _points(sloppy), _points(clean)
+    assert np.abs(pts[bad] - pts[bad[0]]).max() < 1e-8  # two paths on one root
+    assert _distinct(ref) == 56 == 8 * 7
+    assert _distinct(pts) < 56
+    assert all(c != crossings.CROSSING for c in map(_code, clean.solution_metadata()))
+
+
+def test_the_filter_drops_bertinis_line_only_whatever_the_chunks(tmp_path):
+    """Everything else written to stderr passes through, byte for byte, even when Bertini's
+    line and the others arrive cut at any byte (a progress bar's \\r lines included)."""
+    import os
+
+    other = "cotm-bertini: a line\r 10%|#   | bar\rwarning: something else\nwar"
+    text = (other + "\n" + BERTINI_LINE + "tail").encode()
+    expected = (other + "\ntail").encode()
+    for step in (1, 3, 7, 64, len(text)):
+        out = tmp_path / f"out{step}"
+        with open(out, "wb") as f:
+            pump = crossings._Filter(f.fileno())
+            for k in range(0, len(text), step):
+                pump.feed(text[k : k + step])
+            pump.flush()
+            os.fsync(f.fileno())
+        assert out.read_bytes() == expected, step
+        assert pump.dropped == 1
+
+
+def test_the_bertini2_commands_stderr_is_counted():
+    """The bertini2 command's stderr: the numbers of its lines, summed."""
+    assert crossings.count_in("") == 0
+    assert crossings.count_in("x\n" + BERTINI_LINE + BERTINI_LINE.replace("4 path", "3 path")) == 7
+
+
+def test_unresolved_crossings_make_the_framework_run_incomplete(tmp_path):
+    """End to end: Zeeman's wheel solved once (its generic set cached), then again in a process
+    where Bertini flags every path as crossing another (a copy of the cache, so that nothing
+    it finds is kept): the second start and the ab-initio solve cannot part them either, so the
+    run is incomplete (exit 5), run.json counts the crossings and its warnings say them, in the
+    package's words on stderr, with no raw Bertini line."""
+    import os
+    import shutil
+
+    toml = ROOT / "examples" / "zeeman_cables.toml"
+    args = ["solve", "--framework", str(toml), "--no-plots", "--no-cache"]
+    r = run_cli(*args, "--out", str(tmp_path / "a"))
+    assert r.returncode == 0, r.stderr
+    first = json.loads((tmp_path / "a" / "latest" / "run.json").read_text())
+    assert first["counts"]["crossings_unresolved"] == 0
+    shutil.copytree(os.environ["COTM_CACHE"], tmp_path / "cache")
+    script = (
+        "import sys; from cotm_bertini.backends import crossings; "
+        "crossings.flagged = lambda m: True; from cotm_bertini.cli.main import main; "
+        f"sys.exit(main({[*args, '--out', str(tmp_path / 'b')]!r}))"
+    )
+    r = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                       env={**os.environ, "COTM_CACHE": str(tmp_path / "cache")})  # fmt: skip
+    assert r.returncode == 5, r.stderr
+    rec = json.loads((tmp_path / "b" / "latest" / "run.json").read_text())
+    tracked = [v for v in rec["details"]["taut_sets"].values() if "tracked" in v]
+    assert rec["status"] == "incomplete"
+    assert rec["counts"]["crossings_unresolved"] == sum(v["lost"] for v in tracked) > 0
+    assert any("crossed another path" in w for w in rec["warnings"])
+    assert "crossed another path" in r.stderr and "path crossing(s)" not in r.stderr

@@ -257,3 +257,18 @@ def test_cone_points_from_the_search_equal_bertinis(name):
         gaps = [np.abs(np.array(c["pose"]) - np.array(d["pose"])).max() for d in near]
         k = int(np.argmin(gaps))
         assert gaps[k] < 1e-9 and near[k]["is_max"] == c["is_max"]
+
+
+def test_unbounded_products_stay_sound():
+    """0 times an unbounded interval is 0 (no nan); a reciprocal across 0 is unbounded."""
+    inf = np.inf
+    a = Interval(np.array([0.0, 0.0, -1.0]), np.array([0.0, 1.0, 2.0]))
+    b = Interval(np.array([-inf, 1.0, -0.5]), np.array([inf, inf, 0.5])).reciprocal()
+    p = Interval(np.array([0.0, 0.0, -1.0]), np.array([0.0, 1.0, 2.0])) * Interval(
+        np.array([-inf, 1.0, 3.0]), np.array([inf, inf, 4.0])
+    )
+    assert not np.isnan(p.lo).any() and not np.isnan(p.hi).any()
+    assert p.lo[0] <= 0.0 <= p.hi[0] and p.lo[1] <= 0.0 and p.hi[1] == inf
+    assert p.lo[2] <= -4.0 and p.hi[2] >= 8.0
+    assert b.lo[2] == -inf and b.hi[2] == inf  # 1 / [-0.5, 0.5]
+    assert (a + Interval(np.full(3, -inf), np.full(3, inf))).hi[0] == inf

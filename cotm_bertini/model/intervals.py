@@ -98,7 +98,9 @@ class Interval:
             if np.ndim(other) == 0 and other == 0:
                 return self
             other = Interval(other)
-        return Interval(*_clean(_down(self.lo + other.lo), _up(self.hi + other.hi)))
+        # No NaN: a lower bound is never +inf (_down moves an overflow back to the largest
+        # double) nor an upper bound -inf, so inf - inf cannot arise.
+        return Interval(_down(self.lo + other.lo), _up(self.hi + other.hi))
 
     __radd__ = __add__
 
@@ -122,15 +124,16 @@ class Interval:
                 return self
             lo = np.where(c >= 0, c * self.lo, c * self.hi)
             hi = np.where(c >= 0, c * self.hi, c * self.lo)
-            return Interval(
-                *_clean(_down(np.where(c == 0, 0.0, lo)), _up(np.where(c == 0, 0.0, hi)))
-            )
+            return Interval(_down(np.where(c == 0, 0.0, lo)), _up(np.where(c == 0, 0.0, hi)))
         p = [self.lo * other.lo, self.lo * other.hi, self.hi * other.lo, self.hi * other.hi]
         # 0 * inf is nan; as a product of reals (an unbounded end stands for finite numbers) it
-        # is 0, and no input bound is nan (_clean), so 0 is the right value.
-        p = [np.where(np.isnan(v), 0.0, v) if np.isnan(v).any() else v for v in p]
-        lo = np.minimum(np.minimum(p[0], p[1]), np.minimum(p[2], p[3]))
-        hi = np.maximum(np.maximum(p[0], p[1]), np.maximum(p[2], p[3]))
+        # is 0. fmin and fmax pass a nan over, and the other products of that same 0 end give
+        # 0, so only when all four are nan ([0, 0] times [-inf, inf]) is a bound left nan.
+        lo = np.fmin(np.fmin(p[0], p[1]), np.fmin(p[2], p[3]))
+        hi = np.fmax(np.fmax(p[0], p[1]), np.fmax(p[2], p[3]))
+        bad = np.isnan(lo)
+        if bad.any():
+            lo, hi = np.where(bad, 0.0, lo), np.where(bad, 0.0, hi)
         return Interval(_down(lo), _up(hi))
 
     __rmul__ = __mul__
@@ -146,7 +149,7 @@ class Interval:
         if not isinstance(other, Interval):
             c = np.asarray(other, dtype=float)
             lo, hi = np.minimum(self.lo / c, self.hi / c), np.maximum(self.lo / c, self.hi / c)
-            return Interval(*_clean(_down(lo), _up(hi)))
+            return Interval(_down(lo), _up(hi))
         return self * other.reciprocal()
 
     def __rtruediv__(self, other) -> Interval:

@@ -125,7 +125,8 @@ class Interval:
             lo = np.where(c >= 0, c * self.lo, c * self.hi)
             hi = np.where(c >= 0, c * self.hi, c * self.lo)
             return Interval(_down(np.where(c == 0, 0.0, lo)), _up(np.where(c == 0, 0.0, hi)))
-        p = [self.lo * other.lo, self.lo * other.hi, self.hi * other.lo, self.hi * other.hi]
+        with np.errstate(invalid="ignore"):  # 0 * inf: below
+            p = [self.lo * other.lo, self.lo * other.hi, self.hi * other.lo, self.hi * other.hi]
         # 0 * inf is nan; as a product of reals (an unbounded end stands for finite numbers) it
         # is 0. fmin and fmax pass a nan over, and the other products of that same 0 end give
         # 0, so only when all four are nan ([0, 0] times [-inf, inf]) is a bound left nan.

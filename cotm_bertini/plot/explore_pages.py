@@ -10,6 +10,7 @@ import pandas as pd
 
 from ..params import Params
 from .explore import axis_title, page_data, write_page
+from .motion import snaps_text
 
 BLUES = ["#eef4fb", "#c6dbef", "#6baed6", "#2171b5", "#08306b", "#041d42"]
 
@@ -164,5 +165,7 @@ def move_page(mv, path: str | Path) -> Path:
     fig.update_layout(xaxis_title=axis_title(along), yaxis_title=ycol, margin={"t": 30})
     data.update(page="move", labels=_step_labels(table, names),
                 at=table[along].astype(float).tolist())  # fmt: skip
-    note = f"state #{mv.state} moved along {mv.path.as_dict()}: {len(mv.snaps)} snaps."
+    n = len(mv.snaps)
+    note = (f"state #{mv.state} moved along {mv.path.text()}, {n} snap{'' if n == 1 else 's'}"
+            + (f" ({snaps_text(mv)})." if n else "."))  # fmt: skip
     return write_page(path, f"move of state #{mv.state}", note, fig, data, slider="step")

@@ -70,3 +70,29 @@ def test_the_papers_report_lists_its_physical_rows_and_counts_the_rest():
         "62 other rows in the run folder's solutions.csv (not physical: 36 complex, "
         "14 zero_length_spring, 12 negative_d; its column reason says why)"
     )
+
+
+def test_the_pictures_draw_each_load_as_an_arrow_at_its_point():
+    """configurations.png of Zeeman's wheel with a load (fx, fy) = (0.05, -0.1) on its rim:
+    in every panel an arrow whose head is at the rim (from the row's wheel angle and the
+    file's geometry) and which points along the force, labelled by its name and size."""
+    import cotm_bertini as cb
+    from cotm_bertini.plot.framework import framework_figure
+
+    fw = cb.Framework.from_toml(ROOT / "tests" / "fixtures" / "zeeman_load.toml")
+    fw = fw.replace(fx=0.05, fy=-0.1)
+    table = cb.solve(fw).table
+    phys = table[table.physical.astype(bool)]
+    fig = framework_figure(fw, table)
+    panels = [ax for ax in fig.axes if ax.get_title()]
+    assert len(panels) == len(phys) >= 2
+    force = np.array([0.05, -0.1])
+    for ax, (_, row) in zip(panels, phys.iterrows(), strict=True):
+        (arrow,) = [t for t in ax.texts if t.get_gid() == "load-hand"]
+        theta = np.radians(row["wheel.angle_deg"])
+        rim = np.array([1.0 + 0.5 * np.cos(theta), 0.5 * np.sin(theta)])
+        head, tail = np.array(arrow.xy), np.array(arrow.xyann)
+        assert np.abs(head - rim).max() < 1e-9
+        along = (head - tail) / np.linalg.norm(head - tail)
+        assert np.abs(along - force / np.linalg.norm(force)).max() < 1e-9
+        assert arrow.get_text() == f"hand {np.hypot(*force):.3g}"

@@ -135,10 +135,13 @@ def test_a_click_on_the_map_draws_that_grid_points_equilibria(paper_map, browser
     by_id = dict(zip(rows.solution_id, rows.kind, strict=True))
     assert all(d["kind"] == by_id[d["solution_id"]] for d in drawn)
     widths = browser.execute_script(
-        "return document.getElementById('mech').data.map(t => [t.meta.sid, t.line.width])"
+        "return document.getElementById('mech').data.filter(t => t.meta && t.meta.sid)"
+        ".map(t => [t.meta.sid, t.meta.look, t.line.width])"
     )
     stable = set(rows.solution_id[rows.stable.astype(bool)])
-    assert all((w >= 4) == (sid in stable) for sid, w in widths)
+    assert {look for _, look, _ in widths} == {"body", "bar", "spring"}
+    bodies = [(sid, w) for sid, look, w in widths if look in ("body", "bar")]
+    assert all((w >= 4) == (sid in stable) for sid, w in bodies)  # bodies and bars: wider
     browser.save_screenshot(str(ARTEFACTS / "map-clicked.png"))
 
 
@@ -173,6 +176,10 @@ def test_the_move_slider_draws_the_followed_state(browser, tmp_path):
     mv = cb.move(cb.solve(fw), 1, {"y": [-0.8, 0.2, -0.8]}, steps=10)
     page = mv.explore(tmp_path / "explore.html")
     _open(browser, page, "move.png")
+    folds = "; ".join(f"fold at y = {y:.5g}" for y in mv.snaps.y)  # the snaps' own y
+    assert browser.find_element("css selector", "p.note").text == (
+        f"state #1 moved along y: -0.8 -> 0.2 -> -0.8, 2 snaps ({folds})."
+    )
     slider = browser.find_element("id", "slider")
     rim = page_data(page)["skeleton"]["points"].index("wheel.rim")
     for k in range(len(mv.table)):
@@ -250,3 +257,172 @@ def test_a_path_drawn_on_the_map_gives_the_command_that_moves_along_it(paper_map
     stable = ", ".join(str(s) for s in rows.solution_id[rows.stable.astype(bool)])
     assert f"({stable})" in command
     browser.save_screenshot(str(ARTEFACTS / "map-drawn.png"))
+
+
+# --- what the pages show a person ----------------------------------------------------------------
+
+LOADED = ROOT / "tests" / "fixtures" / "zeeman_load.toml"  # Zeeman's wheel, a load on its rim
+FX = 0.1  # the load's x component in the sweep below; its y component is swept
+FYS = (-0.3, 0.0, 0.3)
+
+
+@pytest.fixture(scope="module")
+def loaded_sweep(tmp_path_factory):
+    """A sweep of the rim's load (fx, fy) = (0.1, -0.3 .. 0.3): its table and its page."""
+    out = tmp_path_factory.mktemp("loaded")
+    fw = cb.Framework.from_toml(LOADED).replace(fx=FX)
+    sw = cb.sweep(fw, "fy", np.array(FYS), out=out)
+    return sw.table, sw.explore(out / "explore.html")
+
+
+def _rects_overlap(a: dict, b: dict) -> bool:
+    return not (a["right"] <= b["left"] or b["right"] <= a["left"] or a["bottom"] <= b["top"]
+                or b["bottom"] <= a["top"])  # fmt: skip
+
+
+def _rects(browser, selector: str) -> list[dict]:
+    return browser.execute_script(
+        "return Array.from(document.querySelectorAll(arguments[0])).map(e => {"
+        "const r = e.getBoundingClientRect(); return {left: r.left, right: r.right, top: r.top,"
+        "bottom: r.bottom, text: e.textContent}}).filter(r => r.right > r.left)",
+        selector,
+    )
+
+
+@pytest.mark.parametrize("which", ["map", "sweep"])
+def test_no_panel_title_lies_under_plotlys_toolbar(which, paper_map, loaded_sweep, browser):
+    """With the pointer over each panel (its toolbar showing), no title (the drawing's, a
+    figure's, a colour bar's) shares a pixel with a toolbar; the drawing's title says where."""
+    from selenium.webdriver.common.action_chains import ActionChains
+
+    page = paper_map[1] if which == "map" else loaded_sweep[1]
+    _open(browser, page, f"titles-{which}.png")
+    titles = _rects(browser, "#mech-title, .gtitle, .cbtitle, .g-gtitle")
+    assert any(t["text"].startswith("L01 = " if which == "map" else "fy = ") for t in titles)
+    for panel in ("main", "mech"):
+        ActionChains(browser).move_to_element(browser.find_element("id", panel)).perform()
+        bars = _rects(browser, f"#{panel} .modebar")
+        assert bars, "no toolbar found"
+        assert not [(t, b) for t in titles for b in bars if _rects_overlap(t, b)]
+    browser.save_screenshot(str(ARTEFACTS / f"titles-{which}-hovered.png"))
+
+
+def _lab(rgb) -> np.ndarray:
+    """CIELAB (D65) of an sRGB colour 0-255: the usual formulas, written here."""
+    c = np.asarray(rgb, float) / 255
+    c = np.where(c > 0.04045, ((c + 0.055) / 1.055) ** 2.4, c / 12.92)
+    xyz = np.array([[0.4124, 0.3576, 0.1805], [0.2126, 0.7152, 0.0722],
+                    [0.0193, 0.1192, 0.9505]]) @ c / [0.95047, 1.0, 1.08883]  # fmt: skip
+    f = np.where(xyz > 0.008856, np.cbrt(xyz), 7.787 * xyz + 16 / 116)
+    return np.array([116 * f[1] - 16, 500 * (f[0] - f[1]), 200 * (f[1] - f[2])])
+
+
+def test_each_stable_count_has_a_colour_of_its_own(paper_map, browser):
+    """The map as shown: the pixels at the grid points of each stable count (read from the
+    2-D sweep) share one colour, every two counts' colours differ by a CIELAB distance > 15,
+    and the colour bar has one label a count. The palette's twelve classes differ alike."""
+    import io
+
+    from PIL import Image
+
+    from cotm_bertini.plot.explore_pages import count_colour
+
+    dm, page, table = paper_map
+    _open(browser, page, "counts.png")
+    stable = table[table.physical.astype(bool) & table.stable.astype(bool)]
+    counts = np.bincount(stable.point, minlength=81)
+    shot = Image.open(io.BytesIO(browser.get_screenshot_as_png())).convert("RGB")
+    left, top = browser.execute_script(
+        "const r = document.getElementById('main').getBoundingClientRect(); return [r.left, r.top]"
+    )
+    scale = browser.execute_script("return window.devicePixelRatio")
+    seen: dict[int, list] = {}
+    for k in range(81):
+        i, j = divmod(k, 9)
+        px, py = browser.execute_script(f"return window.explorer.pixel({i}, {j})")
+        seen.setdefault(int(counts[k]), []).append(
+            shot.getpixel((round((left + px) * scale), round((top + py) * scale)))
+        )
+    colour = {}
+    for n, pixels in seen.items():
+        values, freq = np.unique(np.array(pixels), axis=0, return_counts=True)
+        colour[n] = values[np.argmax(freq)]
+        assert freq.max() >= 0.6 * len(pixels), (n, pixels)  # fold dots cover a few
+    assert len(colour) >= 3, colour
+    gaps = [np.linalg.norm(_lab(colour[a]) - _lab(colour[b])) for a in colour for b in colour
+            if a < b]  # fmt: skip
+    assert min(gaps) > 15, (colour, gaps)
+    bar = browser.execute_script("return document.getElementById('main').data[0].colorbar.ticktext")
+    assert [int(t) for t in bar] == list(range(max(colour) + 1))
+    palette = [_lab([int(count_colour(k)[i : i + 2], 16) for i in (1, 3, 5)]) for k in range(12)]
+    assert min(np.linalg.norm(a - b) for n, a in enumerate(palette) for b in palette[n + 1 :]) > 15
+
+
+@pytest.mark.parametrize("width", [1400, 1200, 900])
+def test_the_table_is_whole_or_scrolls_in_its_box(width, loaded_sweep, browser):
+    """At 1400, 1200 and 900 px, the page does not run past the window's right edge, and the
+    table of the drawn equilibria (nine columns) is either whole inside its box or its box
+    scrolls sideways."""
+    _, page = loaded_sweep
+    browser.set_window_size(width, 1000)
+    try:
+        _open(browser, page, f"table-{width}.png")
+        got = browser.execute_script(
+            "const b = document.getElementById('table-box'), t = document.getElementById('rows');"
+            "return {view: document.documentElement.clientWidth,"
+            "page: document.documentElement.scrollWidth, box: b.getBoundingClientRect().right,"
+            "inner: b.clientWidth, wide: t.scrollWidth, overflow: getComputedStyle(b).overflowX,"
+            "cells: t.querySelectorAll('td').length}"
+        )
+    finally:
+        browser.set_window_size(1300, 1000)
+    assert got["cells"] > 0
+    assert got["page"] <= got["view"] and got["box"] <= got["view"], got
+    assert got["wide"] <= got["inner"] or got["overflow"] in ("auto", "scroll"), got
+
+
+def test_the_drawing_tells_bars_springs_cables_and_loads_apart(loaded_sweep, browser):
+    """The loaded wheel at each sweep point: the wheel thick and solid, the spring a zigzag
+    between its ends, the cable dashed, a key to them in the legend; the load an arrow whose
+    head is at the rim (from the row's wheel angle, by the file's geometry) along (fx, fy)."""
+    from selenium.webdriver.common.keys import Keys
+
+    table, page = loaded_sweep
+    _open(browser, page, "loaded.png")
+    slider = browser.find_element("id", "slider")
+    for k, fy in enumerate(FYS):
+        if k:
+            slider.send_keys(Keys.ARROW_RIGHT)
+        rows = _rows_at(table, k)
+        data = browser.execute_script("return document.getElementById('mech').data")
+        looks = {}
+        for t in data:
+            if t.get("meta", {}).get("look"):
+                looks.setdefault(t["meta"]["look"], []).append(t)
+        assert {t["line"]["dash"] for t in looks["cable"]} == {"dash"}
+        assert min(t["line"]["width"] for t in looks["body"]) >= 3
+        assert max(t["line"]["width"] for t in looks["spring"] + looks["cable"]) <= 2
+        assert {t["meta"]["key"] for t in data if "key" in t.get("meta", {})} == {
+            "bar", "spring", "cable", "load"}  # fmt: skip
+        arrows = browser.execute_script("return document.getElementById('mech').layout"
+                                        ".annotations || []")  # fmt: skip
+        band_u = [t for t in looks["spring"] if t["meta"]["element"] == "band_u"]
+        assert len(arrows) == len(rows) == len(band_u)
+        for (_, row), spring in zip(rows.iterrows(), band_u, strict=True):
+            theta = np.radians(row["wheel.angle_deg"])
+            rim = np.array([1.0 + 0.5 * np.cos(theta), 0.5 * np.sin(theta)])
+            xy = np.array([spring["x"], spring["y"]]).T
+            ends = np.array([xy[0], xy[-1]])
+            assert np.abs(ends - [rim, [0.1, -0.25]]).max() < 1e-5  # ground.u = (x, y)
+            axis = (ends[1] - ends[0]) / np.linalg.norm(ends[1] - ends[0])
+            off = np.abs((xy - ends[0]) @ [-axis[1], axis[0]])
+            assert len(xy) > 10 and off.max() > 0.01  # teeth across the spring
+            (arrow,) = [a for a in arrows if np.hypot(a["x"] - rim[0], a["y"] - rim[1]) < 1e-5]
+            along = np.array([arrow["x"] - arrow["ax"], arrow["y"] - arrow["ay"]])
+            force = np.array([FX, fy])
+            assert np.abs(along / np.linalg.norm(along) - force / np.linalg.norm(force)).max(
+            ) < 1e-5  # fmt: skip
+        assert any(a["text"] == f"hand {np.hypot(FX, fy):.3g}" for a in arrows), [
+            a["text"] for a in arrows
+        ]
+    browser.save_screenshot(str(ARTEFACTS / "loaded-end.png"))

@@ -5,6 +5,7 @@ parameter steps each followed by a descent from the previous pose, and closed-fo
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -87,21 +88,29 @@ def zeeman_move():
     return res, move(res, state=int(sid), path={"y": [-0.8, 0.2, -0.8]})
 
 
-def test_zeeman_loop_snaps_where_an_independent_scan_puts_the_folds(zeeman_move):
+def _zeeman_energy_at(y):
+    return lambda t: zeeman_energy(t, (0.1, y), cables=False)
+
+
+@pytest.fixture(scope="module")
+def zeeman_simulated(zeeman_move):
+    """The independent simulation of the loop: (ys, angles, the two fold values of y)."""
+    res, _ = zeeman_move
+    start = np.radians(float(res.stable["wheel.angle_deg"].iloc[0]))
+    ys = np.concatenate([np.linspace(-0.8, 0.2, 1001), np.linspace(0.2, -0.8, 1001)[1:]])
+    sim = quasi_static_1d(_zeeman_energy_at, ys, start)
+    jumps = np.flatnonzero(np.abs(np.diff(sim)) > 0.3)
+    assert len(jumps) == 2
+    folds = [_fold_between(_zeeman_energy_at, ys[k], ys[k + 1], sim[k]) for k in jumps]
+    return ys, sim, folds
+
+
+def test_zeeman_loop_snaps_where_an_independent_scan_puts_the_folds(zeeman_move, zeeman_simulated):
     """Up and back along y at x = 0.1: two folds, where an independent simulation (steps of
     1e-3 in y, each a walk down V(theta) from the previous angle) jumps, refined by bisection
     to 1e-11; the state at each leg's end is the simulation's."""
     res, mv = zeeman_move
-
-    def energy_at(y):
-        return lambda t: zeeman_energy(t, (0.1, y), cables=False)
-
-    start = np.radians(float(res.stable["wheel.angle_deg"].iloc[0]))
-    ys = np.concatenate([np.linspace(-0.8, 0.2, 1001), np.linspace(0.2, -0.8, 1001)[1:]])
-    sim = quasi_static_1d(energy_at, ys, start)
-    jumps = np.flatnonzero(np.abs(np.diff(sim)) > 0.3)
-    assert len(jumps) == 2
-    folds = [_fold_between(energy_at, ys[k], ys[k + 1], sim[k]) for k in jumps]
+    ys, sim, folds = zeeman_simulated
     assert list(mv.snaps.kind) == ["fold", "fold"]
     assert np.abs(mv.snaps.y.to_numpy() - folds).max() < 1e-6, (list(mv.snaps.y), folds)
     assert (mv.snaps.released > 0).all() and mv.status == "ok"
@@ -110,6 +119,24 @@ def test_zeeman_loop_snaps_where_an_independent_scan_puts_the_folds(zeeman_move)
         row = steps[np.isclose(steps.s, s)].iloc[0]
         assert _deg_gap(row["wheel.angle_deg"], np.degrees(sim[k])) < 1e-6
     assert mv.ends_in == int(res.stable.solution_id.iloc[0])  # the loop returns to its state
+
+
+def test_move_png_names_each_snap_by_the_parameter_there(zeeman_move, zeeman_simulated):
+    """move.png's title: `fold at y = ...` with the y of the independent simulation's folds (5
+    significant digits), and y from the path's waypoints at the snap's position s (linear
+    between -0.8, 0.2, -0.8), not the position itself."""
+    from cotm_bertini.plot.motion import move_figure, snaps_text
+
+    _, mv = zeeman_move
+    labels = snaps_text(mv).split("; ")
+    values = [float(re.fullmatch(r"fold at y = (\S+)", label).group(1)) for label in labels]
+    assert np.abs(np.array(values) - zeeman_simulated[2]).max() < 1e-4
+    s = mv.snaps.s.to_numpy()
+    on_path = np.where(s <= 1, -0.8 + s, 0.2 - (s - 1))
+    assert labels == [f"fold at y = {y:.5g}" for y in on_path]
+    title = " ".join(move_figure(mv)._suptitle.get_text().split())
+    assert all(label in title for label in labels) and "s =" not in title
+    assert "along y: -0.8 -> 0.2 -> -0.8" in title
 
 
 def test_every_step_row_is_a_minimum_of_the_independent_energy(zeeman_move):

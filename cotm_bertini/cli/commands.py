@@ -330,9 +330,9 @@ def move(args: argparse.Namespace) -> int:
     folder = found.save(new_run_folder(root), plots=not args.no_plots, html=args.html)
     link_latest(root, folder)
     _warn(found.warnings)
-    along = ", ".join(f"{n} = {p}" for n, p in path.items())
-    print(f"{label} ({describe(model)}): state {args.state} followed along {along}: "
-          f"{len(found.snaps)} snaps")  # fmt: skip
+    n = len(found.snaps)
+    print(f"{label} ({describe(model)}): state {args.state} followed along "
+          f"{found.path.text()}: {n} snap{'' if n == 1 else 's'}")  # fmt: skip
     if len(found.snaps):
         cols = ["snap", *path, "kind", "released"]
         print(found.snaps[cols].to_string(index=False))

@@ -20,17 +20,8 @@ CONTINUA_CSV = "continua.csv"
 RUN_JSON = "run.json"
 COLUMNS_MD = "columns.md"
 FIGURE_STEMS = ("configurations", "energy_map")
-SUMMARY_COLUMNS = [
-    "solution_id",
-    "gamma1_deg",
-    "gamma2_deg",
-    "d1",
-    "d2",
-    "physical",
-    "stable",
-    "kind",
-    "reason",
-]
+# The physical rows' columns (their physical column is all true, their reason empty).
+SUMMARY_COLUMNS = ["solution_id", "gamma1_deg", "gamma2_deg", "d1", "d2", "stable", "kind"]
 
 
 def solve_record(point: PointSolution, tolerances: dict, label: str, key: str | None) -> dict:
@@ -87,13 +78,33 @@ def summary_head(record: dict, cached: bool = False) -> str:
 
 
 def summary_text(record: dict, table: dict) -> str:
-    """The console report of a solve: counts, the real solutions (the caller adds a label)."""
+    """The console report of a solve: counts, the physical solutions, and how many other rows
+    solutions.csv holds and why they are not physical (the caller adds a label)."""
     lines = [summary_head(record)]
-    real = [k for k, r in enumerate(table["is_real"]) if r]
-    if real:
-        lines.append(_real_rows_text(table, real))
+    physical = [k for k, r in enumerate(table["physical"]) if r]
+    lines.append(_rows_text(table, physical) if physical else "(no physical equilibrium)")
+    others = len(table["physical"]) - len(physical)
+    if others:
+        lines.append(f"{others} other {_plural(others, 'row')} in the run folder's solutions.csv "
+                     f"({_others_text(table)}; its column reason says why)")  # fmt: skip
     lines += [continuum_line(c) for c in record.get("continua", [])]
     return "\n".join(lines)
+
+
+def _plural(n: int, word: str) -> str:
+    return word if n == 1 else word + "s"
+
+
+def _others_text(table: dict) -> str:
+    """The rows a solve's report leaves out, counted by their reason (complex, negative_d,
+    cable_pushes, ...: the element's name after the colon dropped), most first."""
+    reasons: dict[str, int] = {}
+    for phys, why in zip(table["physical"], table["reason"], strict=True):
+        if not phys:
+            name = str(why or "not physical").split(":", 1)[0]
+            reasons[name] = reasons.get(name, 0) + 1
+    ranked = sorted(reasons.items(), key=lambda kv: (-kv[1], kv[0]))
+    return "not physical: " + ", ".join(f"{n} {why}" for why, n in ranked)
 
 
 def continuum_line(c: dict) -> str:
@@ -134,8 +145,9 @@ def continua_columns(continua: list[dict]) -> dict[str, list]:
 
 
 def summary_columns(table: dict) -> list[str]:
-    """The columns the console shows: the paper's, or for a framework its pose columns (angles,
-    quaternions, then node coordinates; at most six) with energy and classification."""
+    """The columns the console shows of the physical rows: the paper's, or for a framework its
+    pose columns (angles, quaternions, then node coordinates; at most six) with energy and
+    classification."""
     if all(n in table for n in SUMMARY_COLUMNS):
         return SUMMARY_COLUMNS
     parts = [n.split(".") for n in table if n.count(".") == 1]
@@ -143,11 +155,11 @@ def summary_columns(table: dict) -> list[str]:
     pose = [".".join(p) for p in parts if p[1] in ("angle_deg", "qw", "qx", "qy", "qz")]
     # Entities with no orientation are nodes: their coordinates are their pose.
     pose += [".".join(p) for p in parts if p[1] in ("x", "y", "z") and p[0] not in oriented]
-    return ["solution_id", *pose[:6], "energy", "physical", "stable", "kind", "reason"]
+    return ["solution_id", *pose[:6], "energy", "stable", "kind"]
 
 
-def _real_rows_text(table: dict, rows: list[int]) -> str:
-    """The real solutions as an aligned text table (angles wrapped after rounding to 4 digits,
+def _rows_text(table: dict, rows: list[int]) -> str:
+    """Solutions as an aligned text table (angles wrapped after rounding to 4 digits,
     so 359.99996 prints as 0.0000, not 360.0000)."""
 
     def fmt(name: str, value) -> str:

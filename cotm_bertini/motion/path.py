@@ -34,6 +34,15 @@ class ActuatorPath:
         """{name: waypoints} (run.json)."""
         return {n: self.waypoints[:, j].tolist() for j, n in enumerate(self.names)}
 
+    def text(self) -> str:
+        """The path as a person reads it: `L0c: 1.2 -> 1.6 -> 1.2` (`; ` between parameters)."""
+        return "; ".join(f"{n}: " + " -> ".join(f"{v:g}" for v in self.waypoints[:, j])
+                         for j, n in enumerate(self.names))  # fmt: skip
+
+    def values_text(self, s: float) -> str:
+        """The parameter values at position s: `y = -0.14462` (5 significant digits)."""
+        return ", ".join(f"{n} = {v:.5g}" for n, v in self.at(s).items())
+
 
 def actuator_path(path: Mapping[str, Sequence[float]], known: Mapping[str, float]) -> ActuatorPath:
     """The path {name: [v0, v1, ...]} checked against the model's parameter values `known`

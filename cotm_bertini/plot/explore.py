@@ -27,11 +27,13 @@ PAPER_GEOMETRY = ("L3", "p2x", "p3x", "p3y", "p5x", "p5y", "p6x")  # what places
 
 @dataclass(frozen=True)
 class Skeleton:
-    """What is drawn: named points, and elements (a body's outline, a link) through them."""
+    """What is drawn: named points, elements (a body's outline, a link) through them, and the
+    loads ({name, point: index}), drawn as arrows."""
 
     points: list[str]
     elements: list[dict]
     dim: int
+    loads: tuple[dict, ...] = ()
 
 
 def skeleton(model) -> Skeleton:
@@ -52,7 +54,8 @@ def skeleton(model) -> Skeleton:
         elements.append(_element(body, "body", ring + ring[:1] if len(ring) > 2 else ring))
     for link in model.links:
         elements.append(_element(link.name, link.kind, [index[link.a], index[link.b]]))
-    return Skeleton(names, elements, model.dim)
+    loads = tuple({"name": x.name, "point": index[x.point]} for x in model.loads)
+    return Skeleton(names, elements, model.dim, loads)
 
 
 def _element(name: str, kind: str, points: list[int]) -> dict:
@@ -64,19 +67,37 @@ def coordinates(model, table: pd.DataFrame) -> np.ndarray:
     rows may lie at different parameter values (its columns named as the parameters)."""
     sk = skeleton(model)
     out = np.zeros((len(table), len(sk.points), sk.dim))
+    for here, rows in _parameter_sets(model, table):
+        out[rows] = _points(here, table.iloc[rows], sk)
+    return out
+
+
+def forces(model, table: pd.DataFrame) -> np.ndarray:
+    """(rows, loads, dim): each load's force at each row's parameter values (the paper's
+    mechanism has none)."""
+    loads = getattr(model, "loads", ())
+    out = np.zeros((len(table), len(loads), getattr(model, "dim", 2)))
+    for here, rows in _parameter_sets(model, table) if loads else ():
+        slots = here.slots()
+        out[rows] = [[slots[f"f_{x.name}_{a}"] for a in "xyz"[: here.dim]] for x in loads]
+    return out
+
+
+def _parameter_sets(model, table: pd.DataFrame):
+    """(the model at one set of parameter values, the indices of the table's rows there), for
+    the parameters that are columns of the table (the paper's: those that place its points)."""
     if not len(table):
-        return out
+        return
     varied = [n for n in model.as_dict() if n in table.columns]
     if isinstance(model, Params):
         varied = [n for n in varied if n in PAPER_GEOMETRY]
-    keys = table[varied].to_numpy(float) if varied else np.zeros((len(table), 0))
-    groups = pd.DataFrame(keys).groupby(list(range(keys.shape[1]))).indices if varied else {
-        (): np.arange(len(table))}  # fmt: skip
-    for key, rows in groups.items():
+    if not varied:
+        yield model, np.arange(len(table))
+        return
+    keys = table[varied].to_numpy(float)
+    for key, rows in pd.DataFrame(keys).groupby(list(range(keys.shape[1]))).indices.items():
         key = key if isinstance(key, tuple) else (key,)
-        here = model.replace(**dict(zip(varied, key, strict=True))) if varied else model
-        out[rows] = _points(here, table.iloc[rows], sk)
-    return out
+        yield model.replace(**dict(zip(varied, key, strict=True))), rows
 
 
 def _points(model, rows: pd.DataFrame, sk: Skeleton) -> np.ndarray:
@@ -120,7 +141,8 @@ def page_data(model, rows: pd.DataFrame, point: np.ndarray, points: int) -> dict
     kind = [KIND_CODES.get(str(k), 3) for k in rows.get("kind", pd.Series(["min"] * len(rows)))]
     stable = rows["stable"].astype(bool) if "stable" in rows else pd.Series([True] * len(rows))
     return {
-        "skeleton": {"points": sk.points, "elements": sk.elements}, "dim": sk.dim,
+        "skeleton": {"points": sk.points, "elements": sk.elements, "loads": list(sk.loads)},
+        "dim": sk.dim, "forces": _floats(forces(model, rows)),
         "start": np.searchsorted(point, np.arange(points)).tolist(),
         "count": np.bincount(point, minlength=points).tolist(),
         "id_name": "solution_id" if "solution_id" in rows else "step",

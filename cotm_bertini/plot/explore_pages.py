@@ -10,8 +10,34 @@ import pandas as pd
 
 from ..params import Params
 from .explore import axis_title, page_data, write_page
+from .motion import snaps_text
 
-BLUES = ["#eef4fb", "#c6dbef", "#6baed6", "#2171b5", "#08306b", "#041d42"]
+# A map's stable counts as classes, one colour each: white for none, then ColorBrewer's Set3
+# (light, so the fold curves stay readable over it; its grey swapped for a tan, its orange
+# after the counts met most often, as the fold curves are orange): any two of these twelve
+# differ by a CIELAB distance of at least 18.
+COUNT_COLOURS = ("#ffffff", "#80b1d3", "#b3de69", "#fb8072", "#bebada", "#ffed6f", "#8dd3c7",
+                 "#fdb462", "#bc80bd", "#fccde5", "#ccebc5", "#e5c494")  # fmt: skip
+
+
+def count_colour(k: int) -> str:
+    """The colour of a stable count k (past the twelfth class, the palette again in a darker
+    shade: 12 is white's darker twin, a mid grey)."""
+    base = COUNT_COLOURS[k % len(COUNT_COLOURS)]
+    shade = 0.6 ** (k // len(COUNT_COLOURS))
+    return "#" + "".join(f"{round(int(base[i : i + 2], 16) * shade):02x}" for i in (1, 3, 5))
+
+
+def count_scale(top: int) -> tuple[list, dict]:
+    """A stepped colour scale for counts 0..top over z in [-0.5, top + 0.5] (each count one
+    flat band), and its colour bar: a tick at each count, labelled by it."""
+    scale = []
+    for k in range(top + 1):
+        scale += [[k / (top + 1), count_colour(k)], [(k + 1) / (top + 1), count_colour(k)]]
+    bar = {"title": {"text": "stable<br>states"}, "tickvals": list(range(top + 1)),
+           "ticktext": [str(k) for k in range(top + 1)], "outlinewidth": 1,
+           "outlinecolor": "#888"}  # fmt: skip
+    return scale, bar
 
 
 def map_page(dm, path: str | Path, route: pd.DataFrame | None = None, move=None) -> Path:
@@ -29,11 +55,11 @@ def map_page(dm, path: str | Path, route: pd.DataFrame | None = None, move=None)
     table = read_table(Path(dm.record["sweep_folder"]) / "sweep.csv")
     phys = table[table.physical.astype(bool)]
     data = page_data(model, phys, phys.point.to_numpy(int), len(xs) * len(ys))
-    top = max(int(grid["stable"].max()), 1)
-    scale = [[k / top, BLUES[min(k, len(BLUES) - 1)]] for k in range(top + 1)]
+    top = int(grid["stable"].max())
+    scale, bar = count_scale(top)
     fig = go.Figure(go.Heatmap(
-        x=xs, y=ys, z=grid["stable"], customdata=grid["physical"], colorscale=scale, zmin=0,
-        zmax=top, colorbar={"title": {"text": "stable"}, "dtick": 1}, name="stable count",
+        x=xs, y=ys, z=grid["stable"], customdata=grid["physical"], colorscale=scale,
+        zmin=-0.5, zmax=top + 0.5, colorbar=bar, name="stable count",
         hovertemplate=f"{x} = %{{x}}<br>{y} = %{{y}}<br>stable: %{{z}}<br>"
         "physical: %{customdata}<extra></extra>"))  # fmt: skip
     for trace in _fold_traces(dm, x, y, xs, ys):
@@ -164,5 +190,7 @@ def move_page(mv, path: str | Path) -> Path:
     fig.update_layout(xaxis_title=axis_title(along), yaxis_title=ycol, margin={"t": 30})
     data.update(page="move", labels=_step_labels(table, names),
                 at=table[along].astype(float).tolist())  # fmt: skip
-    note = f"state #{mv.state} moved along {mv.path.as_dict()}: {len(mv.snaps)} snaps."
+    n = len(mv.snaps)
+    note = (f"state #{mv.state} moved along {mv.path.text()}, {n} snap{'' if n == 1 else 's'}"
+            + (f" ({snaps_text(mv)})." if n else "."))  # fmt: skip
     return write_page(path, f"move of state #{mv.state}", note, fig, data, slider="step")

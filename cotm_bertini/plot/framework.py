@@ -18,6 +18,7 @@ _STYLE = {
     "cable": {"color": "tab:green", "lw": 1.0, "ls": "--"},
     "bar": {"color": "black", "lw": 3.0},
 }
+LOAD_COLOUR = "tab:red"
 
 
 def _point(fw: Framework, row: pd.Series, name: str) -> np.ndarray:
@@ -30,6 +31,8 @@ def _point(fw: Framework, row: pd.Series, name: str) -> np.ndarray:
 
 
 def _draw(ax, fw: Framework, row: pd.Series) -> None:
+    """One pose: bodies, links, pins, ground points, nodes, and loads as arrows."""
+
     def line(a, b, **style):
         pts = np.array([_point(fw, row, a), _point(fw, row, b)]).T
         ax.plot(*pts, **style)
@@ -50,10 +53,44 @@ def _draw(ax, fw: Framework, row: pd.Series) -> None:
         ax.scatter(*ground.T, marker="^", s=30, color="0.3", zorder=4)
     for node in fw.nodes:
         ax.scatter(*_point(fw, row, node), s=14, color="black", zorder=5)
+    _draw_loads(ax, fw, row)
+
+
+def _draw_loads(ax, fw: Framework, row: pd.Series) -> None:
+    """Each load: an arrow along its force whose head is at the loaded point, a fifth of the
+    pose's size long, labelled by its name and size (gid `load-<name>`)."""
+    if not fw.loads:
+        return
+    names = [f"{b}.{p}" for b, pts in fw.bodies for p, _ in pts] + list(fw.nodes)
+    names += [f"ground.{g}" for g, _ in fw.ground]
+    xyz = np.array([_point(fw, row, n) for n in names])
+    length = 0.2 * max(float(np.ptp(xyz, axis=0).max()), 1e-9)
+    slots = fw.slots()
+    for load in fw.loads:
+        force = np.array([slots[f"f_{load.name}_{_AXES[a]}"] for a in range(fw.dim)])
+        size = float(np.linalg.norm(force))
+        if size == 0:
+            continue
+        head = _point(fw, row, load.point)
+        tail = head - length * force / size
+        if fw.dim == 2:
+            arrow = {"arrowstyle": "-|>", "color": LOAD_COLOUR, "lw": 1.6}
+            ax.annotate(f"{load.name} {size:.3g}", xy=head, xytext=tail, fontsize=7,
+                        color=LOAD_COLOUR, ha="center", va="center", gid=f"load-{load.name}",
+                        arrowprops=arrow)  # fmt: skip
+            ax.update_datalim([tail])  # the arrow's tail inside the view
+        else:
+            ax.quiver(*tail, *(head - tail), color=LOAD_COLOUR, arrow_length_ratio=0.3,
+                      gid=f"load-{load.name}")  # fmt: skip
 
 
 def plot_framework(fw: Framework, solutions: pd.DataFrame, path: str | Path) -> list[Path]:
-    """configurations.{png,svg}: one panel per physical equilibrium, stable ones marked."""
+    """configurations.{png,svg}: see framework_figure."""
+    return save(framework_figure(fw, solutions), path)
+
+
+def framework_figure(fw: Framework, solutions: pd.DataFrame) -> Figure:
+    """One panel per physical equilibrium, stable ones marked, loads drawn as arrows."""
     rows = physical_rows(solutions)
     n = max(len(rows), 1)
     cols = min(4, n)
@@ -72,11 +109,12 @@ def plot_framework(fw: Framework, solutions: pd.DataFrame, path: str | Path) -> 
     if not len(rows):
         fig.add_subplot(1, 1, 1).text(0.5, 0.5, "no physical equilibrium", ha="center")
     values = values_line(fw.values)
+    loads = ", red arrows: loads" if fw.loads else ""
     set_title(
         fig,
         f"{fw.name}: every physical equilibrium (orange: bodies, blue: springs, green dashed: "
-        "taut cables, grey dotted: slack, black: bars)" + (f"\n{values}" if values else ""),
+        f"taut cables, grey dotted: slack, black: bars{loads})" + (f"\n{values}" if values else ""),
         fontsize=9,
     )
     fig.tight_layout()
-    return save(fig, path)
+    return fig

@@ -37,9 +37,21 @@ def _against(move) -> tuple[str, np.ndarray]:
     return "path position s (1 a segment)", table["s"].to_numpy(float)
 
 
+def snaps_text(move) -> str:
+    """Each snap by its kind and the parameter values where it happens (`fold at y = -0.14462`),
+    or `none`."""
+    return "; ".join(f"{r.kind} at {move.path.values_text(r.s)}"
+                     for r in move.snaps.itertuples()) or "none"  # fmt: skip
+
+
 def plot_move(move, path: str | Path) -> list[Path]:
+    """move.png/svg: see move_figure."""
+    return save(move_figure(move), path)
+
+
+def move_figure(move) -> Figure:
     """The state's coordinate and energy against the actuator (a hysteresis loop where the path
-    returns), arrows at snaps."""
+    returns), arrows at snaps; the title names each snap by its parameter values."""
     table = move.table
     name = _coordinate(move)
     label, h = _against(move)
@@ -59,10 +71,10 @@ def plot_move(move, path: str | Path) -> list[Path]:
         ax.set_ylabel(ylabel)
         ax.grid(True, lw=0.3, alpha=0.5)
     bottom.set_xlabel(label)
-    kinds = ", ".join(f"{r.kind} at s = {r.s:.6g}" for r in move.snaps.itertuples()) or "none"
     fixed = values_line(move.params.as_dict(), move.path.names)
-    set_title(fig, f"move of state #{move.state}: snaps (red arrows): {kinds}\n{fixed}", fontsize=9)
-    return save(fig, path)
+    set_title(fig, f"move of state #{move.state} along {move.path.text()}: snaps (red arrows): "
+              f"{snaps_text(move)}\n{fixed}", fontsize=9)  # fmt: skip
+    return fig
 
 
 def animate_move(move, path: str | Path, frames: int = 80) -> Path:

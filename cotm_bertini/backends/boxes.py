@@ -180,7 +180,7 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, acc: dict)
         decided[test[~zero]] = True
         cand = test[zero & (width[test] <= KRAWCZYK_WIDTH)]
         if len(cand):
-            verdict, k_lo, k_hi = krawczyk(land, lo[cand], hi[cand], _subset(states, test[zero]))
+            verdict, k_lo, k_hi = krawczyk(land, lo[cand], hi[cand], _subset(states, cand))
             decided[cand[verdict != 0]] = True
             one = verdict == 1
             if one.any():
@@ -218,10 +218,10 @@ def _root_near(land: BoxLandscape, lo: np.ndarray, hi: np.ndarray, steps: int = 
     return ok & ((x >= lo - w) & (x <= hi + w)).all(axis=1) & np.isfinite(x).all(axis=1)
 
 
-def _subset(states, mask: np.ndarray):
-    """The landscape's per-box states kept for the boxes in `mask`."""
+def _subset(states, rows: np.ndarray):
+    """The landscape's per-box states of the boxes `rows` (indices into the batch)."""
     if isinstance(states, dict):
-        return {k: v[mask] for k, v in states.items()}
+        return {k: v[rows] for k, v in states.items()}
     return states
 
 

@@ -274,13 +274,15 @@ def _extrapolated(seen: list[tuple[float, float]], width: float) -> tuple[float,
         return None
     x = np.array([p for p, _ in chosen]) - chosen[0][0]
     y = np.array([g for _, g in chosen])
+    if y[1] == y[0]:
+        return None  # no change to extrapolate (no fold: a cable switch, say)
     line = chosen[0][0] - y[0] * x[1] / (y[1] - y[0])
     if len(chosen) == 2:
         return float(line), float(width)
     c = np.linalg.solve(np.vander(x, 3), y)  # c0 x^2 + c1 x + c2
-    roots = np.roots(c) if abs(c[0]) > 0 else np.array([-c[2] / c[1]])
+    roots = np.roots(c)  # np.roots drops leading zeros: a line's one root
     roots = roots[np.isreal(roots)].real + chosen[0][0]
-    if not len(roots):
+    if not len(roots) or not np.isfinite(roots).all():
         return float(line), float(width)
     value = float(roots[np.argmin(np.abs(roots - line))])
     return value, float(abs(value - line))

@@ -9,14 +9,20 @@ close in on it from both sides. Each event is named by what happens there:
 
 - cable_switch: the equilibria that appear (or vanish) have a cable at its free length there
   (the taut and the slack branch end together, the Hessian regular): located where that cable's
-  length equals its free length (framework_switch.py), not by the counts;
+  length equals its free length (framework_switch.py), not by the counts; one event per switch
+  (a taut and a slack row born together: a border collision);
 - pitchfork: the physical count changes by two on a third equilibrium, present on both sides,
   through the pair's meeting point (a min and two saddles, or a saddle and two minima meet);
 - fold: the physical count changes by two otherwise (a pair is born or meets and vanishes, the
   reduced Hessian singular there);
-- physical_change: it changes by one (a length reaching 0);
+- physical_change: it changes by one (a length reaching 0; an equilibrium leaving or entering
+  a cone point of V is located where the pull there equals k L0: framework_cones.py);
 - stability_change: the number of stable equilibria changes (at the events above too, as for
   the paper's model).
+
+A sweep point whose solve is incomplete or degenerate places no bracket end (its neighbours
+bracket the event; the description says which point was left out). A fold the probes cannot
+close in on is placed by extrapolating the merging pair's eigenvalue product.
 
 The pose is that of the equilibria that appear: the rows of the bracket's end with more that
 have no counterpart at the other end (of a cable switch, the followed row where the cable is at

@@ -313,17 +313,25 @@ FRAMEWORK_SWEEP = {
 FRAMEWORK_EVENTS = {
     "kind": "what happens there: cable_switch (equilibria appear or vanish where a cable of theirs "
     "reaches its free length: the taut and the slack branch end together, the Hessian regular, "
-    "so no fold), fold (the number of physical equilibria changes by two: a pair is born or "
+    "so no fold; a pair born or vanishing there is a border collision, one row each, and two "
+    "pairs at one switch are two rows), fold (the number of physical equilibria changes by two: "
+    "a pair is born or "
     "meets and vanishes, the reduced Hessian singular there), pitchfork (it changes by two on a "
     "third equilibrium, present on both sides, through the pair's meeting point: a min and two "
     "saddles, or a saddle and two minima, meet), physical_change "
-    "(it changes by one: a length reaches 0) or stability_change (the number of stable ones "
+    "(it changes by one: a length reaches 0; where an equilibrium comes out of or goes into a "
+    "cone point of V, a spring with a free length at zero length, the description says so) or "
+    "stability_change (the number of stable ones "
     "changes; at the events above too)",
     "branches": "the branch ids of the rows involved (a+b; a+b+c at a pitchfork, the third "
     "branch among them) at the neighbouring sweep point where they exist: its physical rows "
     "nearest in pose to the event",
     "<param>": "the event's parameter value: the middle of the final bisection bracket; of a "
-    "cable switch, where the followed equilibrium's cable length equals its free length",
+    "fold the probes could not close in on (the solver sees the merging pair as one degenerate "
+    "root or leaves it undecided), the zero of the parabola through three probes of the merging "
+    "pair's eigenvalue product; of a cable switch, where the followed equilibrium's cable "
+    "length equals its free length; of an equilibrium leaving a cone point, where the other "
+    "elements' pull there equals the spring's k L0",
     "pose columns": "BODY.angle_deg (planar), BODY.qw ... (spatial), NODE.x ...: the mean pose "
     "of the equilibria that appear or vanish, at the bracket's end where they are real (those "
     "with no counterpart at the other end); of a stability change alone, of the row whose "
@@ -337,9 +345,16 @@ FRAMEWORK_EVENTS = {
     "a failed check: at a fold, the merging pair taken as one root) places no end; a cable "
     "switch: also its secant converged",
     "bracket": "the value's accuracy: the final bisection bracket's width (1e-9 relative, or as "
-    "narrow as the probes that see the event allow); of a cable switch, the secant's last step "
-    "on d - L0 of its cable (converged to 1e-9 relative)",
-    "description": "what happens, in words (a cable switch names its cable)",
+    "narrow as the probes that see the event allow); of an extrapolated fold, the parabola's "
+    "zero's distance from the line's through the two nearest probes; of a cable switch or a "
+    "cone point, the secant's next step on d - L0 of its cable or on pull - k L0 (converged to "
+    "1e-9 relative; 0 where it landed exactly, as on a branch that does not depend on the "
+    "parameter)",
+    "description": "what happens, in words (a cable switch names its cable, a cone point its "
+    "spring); where sweep points between the two that bracket the event were left out (a point "
+    "whose solve is incomplete or has a degenerate equilibrium, e.g. one sitting on a cable's "
+    "switch, places no bracket end: its counts may be wrong), it ends with '; sweep point "
+    "P = v left out (incomplete or degenerate solve)'",
     "lo, hi": "the sweep points on either side (where the counts change twice between them, "
     "each event is found and carries both)",
 }

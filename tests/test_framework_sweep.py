@@ -99,13 +99,20 @@ def test_stable_equilibria_match_the_scan_at_every_tenth_point(zeeman_sweep):
         assert np.abs(gap).max() < 1e-4, y  # deg; the scan is coarse where V is flat
 
 
-def test_points_are_continued_by_newton(zeeman_sweep):
-    """All but the first point continue from their neighbour with a completeness proof."""
-    methods = zeeman_sweep.record["methods"]
+def test_points_are_continued_by_newton(tmp_path):
+    """On the complex route all but the first point continue from their neighbour with a
+    completeness proof; on the real route (the default here) every point is searched."""
+    fw = cb.Framework.from_toml(ZEEMAN).replace(x=X)
+    sw = cb.sweep(fw, "y", VALUES[:60], out=tmp_path, route="complex")
+    methods = sw.record["methods"]
     newton = sum(n for m, n in methods.items() if m.startswith("Newton"))
-    assert newton >= 0.95 * zeeman_sweep.record["rows"]
-    table = zeeman_sweep.table
-    assert table.groupby("point").size().eq(16).all()  # the generic count at every point
+    assert newton >= 0.95 * sw.record["rows"]
+    assert sw.table.groupby("point").size().eq(16).all()  # the generic count at every point
+
+
+def test_the_default_sweep_searches_every_point_on_the_real_route(zeeman_sweep):
+    assert set(zeeman_sweep.record["methods"]) == {"real route (branch and bound)"}
+    assert zeeman_sweep.table["is_real"].all()
 
 
 def test_branches_follow_the_equilibria(zeeman_sweep):

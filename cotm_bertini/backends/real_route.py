@@ -206,10 +206,7 @@ class TorusFramework:
 
     def endpoints(self, roots: np.ndarray) -> dict[tuple[str, ...], Endpoints]:
         """The critical points (R, n angles) as endpoints of their taut sets' systems."""
-        point = Interval(roots)
-        dds, _, _ = self.parts(point)
-        d = {x.name: np.sqrt(np.maximum(dd.mid, 0.0)) for x, dd in zip(self.links, dds,
-                                                                       strict=True)}  # fmt: skip
+        d = self._lengths(roots)
         taut = np.ones((len(roots), len(self.cables)), dtype=bool)
         for j, c in enumerate(self.cables):
             x = next((y for y in self.links if y.name == c), None)
@@ -221,6 +218,17 @@ class TorusFramework:
             names = tuple(c for c, on in zip(self.cables, key, strict=True) if on)
             out[names] = self._endpoints(framework_system(self.fw, names), roots[rows], d, rows)
         return out
+
+    def endpoints_of(self, taut: tuple[str, ...], angles: np.ndarray) -> Endpoints:
+        """Poses (R, n angles) as endpoints of taut set `taut`'s system whatever the cables'
+        lengths there (a start for Newton on one smooth piece of V, followed past a switch)."""
+        fs = framework_system(self.fw, taut)
+        return self._endpoints(fs, angles, self._lengths(angles), np.arange(len(angles)))
+
+    def _lengths(self, angles: np.ndarray) -> dict[str, np.ndarray]:
+        dds, _, _ = self.parts(Interval(angles))
+        return {x.name: np.sqrt(np.maximum(dd.mid, 0.0)) for x, dd in zip(self.links, dds,
+                                                                          strict=True)}  # fmt: skip
 
     def _endpoints(self, fs: FrameworkSystem, angles: np.ndarray, d: dict, rows) -> Endpoints:
         links = {x.name: x for x in self.links}

@@ -66,6 +66,8 @@ def check_param(fw: Framework, name: str | None, option: str) -> None:
 
 def point_method(details: dict) -> str:
     """How a framework point was solved: its taut sets' methods, each once."""
+    if "real_search" in details:
+        return "real route (branch and bound)"
     methods = [r["method"] for r in details.get("taut_sets", {}).values() if "method" in r]
     return "; ".join(dict.fromkeys(methods)) or "no taut set solved (continuum only)"
 

@@ -9,14 +9,20 @@ close in on it from both sides. Each event is named by what happens there:
 
 - cable_switch: the equilibria that appear (or vanish) have a cable at its free length there
   (the taut and the slack branch end together, the Hessian regular): located where that cable's
-  length equals its free length (framework_switch.py), not by the counts;
+  length equals its free length (framework_switch.py), not by the counts; one event per switch
+  (a taut and a slack row born together: a border collision);
 - pitchfork: the physical count changes by two on a third equilibrium, present on both sides,
   through the pair's meeting point (a min and two saddles, or a saddle and two minima meet);
 - fold: the physical count changes by two otherwise (a pair is born or meets and vanishes, the
   reduced Hessian singular there);
-- physical_change: it changes by one (a length reaching 0);
+- physical_change: it changes by one (a length reaching 0; an equilibrium leaving or entering
+  a cone point of V is located where the pull there equals k L0: framework_cones.py);
 - stability_change: the number of stable equilibria changes (at the events above too, as for
   the paper's model).
+
+A sweep point whose solve is incomplete or degenerate places no bracket end (its neighbours
+bracket the event; the description says which point was left out). A fold the probes cannot
+close in on is placed by extrapolating the merging pair's eigenvalue product.
 
 The pose is that of the equilibria that appear: the rows of the bracket's end with more that
 have no counterpart at the other end (of a cable switch, the followed row where the cable is at
@@ -32,7 +38,8 @@ import numpy as np
 
 from ..progress import Progress
 from .framework import pose_coordinates, pose_names
-from .framework_switch import Switch, candidate_cable, locate_switch
+from .framework_cones import Cone, locate_cone
+from .framework_switch import Follower, Switch, candidate_cable, locate_switch
 from .matching import point_keys, point_order
 
 BISECT_TOL = 1e-9  # relative to max(1, |parameter|): the bracket's final width
@@ -59,27 +66,48 @@ def framework_event_records(spec, table) -> list[dict]:
     order = point_order(table, param)
     rows = {k: np.flatnonzero(keys == k) for k, _ in order}
     part = [{n: np.asarray(table[n])[rows[k]] for n in table} for k, _ in order]
+    # A sweep point whose solve is incomplete (an equilibrium at a cable's free length, boxes
+    # left undecided) or has a degenerate equilibrium places no bracket end: its counts may be
+    # wrong, and an event there would be a fake. Its neighbours bracket what happens instead.
+    usable = [r for r in range(len(order)) if _usable(part[r])]
     events: list[dict] = []
-    changed = [r for r in range(len(order) - 1) if _signature(part[r]) != _signature(part[r + 1])]
+    pairs = [(r, t) for r, t in zip(usable, usable[1:], strict=False)
+             if _signature(part[r]) != _signature(part[t])]  # fmt: skip
     # Each bisection probe is a full solve (minutes on a large framework, more when a probe
     # needs another generic set): said as it goes, after the sweep's last point.
-    with Progress("sweep: events refined", len(changed), "intervals", heartbeat=True) as report:
-        for r in changed:
-            (pa, pb), lo, past = (order[r][1], order[r + 1][1]), order[r][1], None
+    with Progress("sweep: events refined", len(pairs), "intervals", heartbeat=True) as report:
+        for r, t in pairs:
+            (pa, pb), lo, past = (order[r][1], order[t][1]), order[r][1], None
+            note = _left_out(param, [order[k][1] for k in range(r + 1, t)])
             for _ in range(MAX_EVENTS):
                 if lo >= pb:
                     break
                 bracket = replace(_bisect(spec, lo, pb, past), start=(pa, pb))
-                switch = _switch(spec, bracket)
-                events.extend(_describe(spec, bracket, (part[r], part[r + 1]), switch))
+                switches = _switches(spec, bracket)
+                events.extend(_describe(spec, bracket, (part[r], part[t]), switches, note))
                 # Two events between neighbouring points (their counts change twice): the
                 # rest of the interval is searched again from the bracket's upper end, its
                 # solve kept.
-                if _signature(bracket.above.columns) == _signature(part[r + 1]):
+                if _signature(bracket.above.columns) == _signature(part[t]):
                     break
                 lo, past = bracket.hi, bracket.above
             report.update(1, note=f"{len(events)} events")
     return sorted(events, key=lambda e: (e[param], e["kind"], e["branches"]))
+
+
+def _usable(cols) -> bool:
+    """A sweep point's solve is complete and has no degenerate equilibrium."""
+    status = set(np.asarray(cols["status"], dtype=object).tolist())
+    kind = np.asarray(cols["kind"], dtype=object)[np.asarray(cols["physical"], dtype=bool)]
+    return status <= {"ok"} and not (kind == "degenerate").any()
+
+
+def _left_out(param: str, values: list[float]) -> str:
+    """The note of an event bracketed across sweep points left out of the comparison."""
+    if not values:
+        return ""
+    said = ", ".join(f"{v:.10g}" for v in values)
+    return f"; sweep point {param} = {said} left out (incomplete or degenerate solve)"
 
 
 @dataclass(frozen=True)
@@ -90,6 +118,7 @@ class _Bracket:
     above: object  # ... at hi
     refined: bool
     start: tuple[float, float]  # the sweep points on either side
+    estimate: tuple[float, float] | None = None  # a fold left wider than tol: (value, error)
 
 
 def _bisect(spec, pa: float, pb: float, below=None) -> _Bracket:
@@ -135,7 +164,10 @@ def _bisect(spec, pa: float, pb: float, below=None) -> _Bracket:
         if low_side == real_low:
             seen.append((value, _pair_product(probe.columns)))
         widths.append(hi - lo)
-    return _Bracket(lo, hi, below, above, ok, (pa, pb))
+    estimate = _extrapolated(seen, hi - lo) if fold and hi - lo > tol else None
+    if estimate is not None and not 2 * lo - hi <= estimate[0] <= 2 * hi - lo:
+        estimate = None  # not where the probes saw the event: the middle is said instead
+    return _Bracket(lo, hi, below, above, ok, (pa, pb), estimate)
 
 
 def _solver(spec):
@@ -152,29 +184,58 @@ def _solver(spec):
     return solve
 
 
-def _switch(spec, b: _Bracket) -> Switch | None:
-    """The cable switch that causes the bracket's count change, located where its cable is at
-    its free length (framework_switch.py), if the equilibria that appear have a cable near its
-    free length and the located switch lies in the bracket (widened by its width); else None."""
+def _switches(spec, b: _Bracket) -> list[tuple[Switch, list[int]]]:
+    """The cable switches that cause the bracket's count change: each appearing row followed
+    along its branch to where a cable near its free length is at it (framework_switch.py), the
+    rows that meet at one switch grouped (a taut and a slack row born together); [] unless every
+    appearing row has one in the bracket (widened by its width)."""
     (n_lo, _), (n_hi, _) = _signature(b.below.columns), _signature(b.above.columns)
     if n_lo == n_hi:
-        return None
+        return []
     fw, param = spec.model, spec.param
     ends = [(b.lo, b.below.columns), (b.hi, b.above.columns)]
     (p_more, more), (p_less, less) = ends if n_lo > n_hi else ends[::-1]
     take = _new_rows(fw, more, less, abs(n_hi - n_lo))
-    found = candidate_cable(fw, more, take, p_more, param)
-    if found is None:
-        return None
     solve, warm = _solver(spec), b.below.warm
     tol = BISECT_TOL * max(1.0, abs(b.lo), abs(b.hi))
-    switch = locate_switch(
-        spec, lambda v: solve(v, warm), (p_more, more, found[0]), (p_less, less), found[1], tol
-    )
     width = b.hi - b.lo + tol
-    if switch is None or not b.lo - width <= switch.value <= b.hi + width:
-        return None
-    return switch
+    found = []
+    for row in take:
+        cable = candidate_cable(fw, more, [row], p_more, param)
+        if cable is None:
+            return []
+        follow = Follower(fw, param, more, cable[0], cable[1], lambda v: solve(v, warm))
+        switch = locate_switch(fw, param, follow, (p_more, more, cable[0]), p_less, tol)
+        if switch is None or not b.lo - width <= switch.value <= b.hi + width:
+            return []
+        found.append((switch, int(row)))
+    return _grouped(fw, more, found, width)
+
+
+def _grouped(fw, cols, found: list, width: float) -> list[tuple[Switch, list[int]]]:
+    """Switches of one cable at one value (within `width`) paired with the nearest in pose
+    (a pair born or vanishing together there); the rest alone."""
+    pose = pose_coordinates(fw, cols)
+    left, out = list(found), []
+    while left:
+        switch, row = left.pop(0)
+        mates = [k for k, (s, r) in enumerate(left)
+                 if s.cable == switch.cable and abs(s.value - switch.value) <= width]  # fmt: skip
+        if mates:
+            k = min(mates, key=lambda k: np.linalg.norm(pose[left[k][1]] - pose[row]))
+            out.append((switch, [row, left.pop(k)[1]]))
+        else:
+            out.append((switch, [row]))
+    return out
+
+
+def _cone(spec, b: _Bracket) -> Cone | None:
+    """The cone event (framework_cones.py) that causes the bracket's count change of one, if
+    one lies in the bracket (widened by its width)."""
+    tol = BISECT_TOL * max(1.0, abs(b.lo), abs(b.hi))
+    width = b.hi - b.lo + tol
+    cone = locate_cone(spec.model, spec.param, b.start[0], b.start[1], tol)
+    return cone if cone is not None and b.lo - width <= cone.value <= b.hi + width else None
 
 
 def _next_probe(
@@ -212,6 +273,35 @@ def _pair_product(cols) -> float:
     return float(np.prod(eig)) if len(eig) == 2 else float("nan")
 
 
+def _extrapolated(seen: list[tuple[float, float]], width: float) -> tuple[float, float] | None:
+    """(value, error) of a fold the probes could not close in on (the solver sees the merging
+    pair as one degenerate root, or none, within `width` of it): the zero of the parabola through
+    three real-side probes of the pair's eigenvalue product (it vanishes linearly there), each
+    at least width / 2 from the last, the nearest first; the error its distance from the line's
+    zero through the first two. None with fewer than two such probes."""
+    pts = sorted(seen, key=lambda v: abs(v[0] - seen[-1][0]))
+    chosen = [pts[0]]
+    for v in pts[1:]:
+        if len(chosen) < 3 and abs(v[0] - chosen[-1][0]) >= width / 2 and np.isfinite(v[1]):
+            chosen.append(v)
+    if len(chosen) < 2 or not np.isfinite(chosen[0][1]):
+        return None
+    x = np.array([p for p, _ in chosen]) - chosen[0][0]
+    y = np.array([g for _, g in chosen])
+    if y[1] == y[0]:
+        return None  # no change to extrapolate (no fold: a cable switch, say)
+    line = chosen[0][0] - y[0] * x[1] / (y[1] - y[0])
+    if len(chosen) == 2:
+        return float(line), float(width)
+    c = np.linalg.solve(np.vander(x, 3), y)  # c0 x^2 + c1 x + c2
+    roots = np.roots(c)  # np.roots drops leading zeros: a line's one root
+    roots = roots[np.isreal(roots)].real + chosen[0][0]
+    if not len(roots) or not np.isfinite(roots).all():
+        return float(line), float(width)
+    value = float(roots[np.argmin(np.abs(roots - line))])
+    return value, float(abs(value - line))
+
+
 def _secant(seen: list[tuple[float, float]]) -> float | None:
     """Where the secant through the two real-side probes nearest the fold reaches 0, or None."""
     if len(seen) < 2:
@@ -222,63 +312,82 @@ def _secant(seen: list[tuple[float, float]]) -> float | None:
     return p2 + g2 * (p2 - p1) / (g1 - g2)
 
 
-def _describe(spec, b: _Bracket, grids: tuple[dict, dict], switch: Switch | None) -> list[dict]:
-    """The events of one refined bracket (`grids`: the sweep points on either side; `switch`:
-    the located cable switch that causes its count change, if one does)."""
+def _describe(spec, b: _Bracket, grids: tuple[dict, dict], switches: list, note: str) -> list:
+    """The events of one refined bracket (`grids`: the sweep points on either side; `switches`:
+    the located cable switches that cause its count change, with their rows; `note`: sweep
+    points left out between them)."""
     fw, param = spec.model, spec.param
     lo_cols, hi_cols = b.below.columns, b.above.columns
     (n_lo, s_lo), (n_hi, s_hi) = _signature(lo_cols), _signature(hi_cols)
     more, less = (lo_cols, hi_cols) if n_lo >= n_hi else (hi_cols, lo_cols)
     grid, other = grids if n_lo >= n_hi else grids[::-1]
-    change = abs(n_hi - n_lo)
-    value = switch.value if switch else 0.5 * (b.lo + b.hi)
-    base = {param: value, "refined": b.refined and (switch is None or switch.converged),
-            "bracket": switch.step if switch else b.hi - b.lo,
-            "lo": float(b.start[0]), "hi": float(b.start[1])}  # fmt: skip
-    # The equilibria that appear (or vanish): those of the side with more that have no
-    # counterpart on the other (the rest barely move across the bracket); with none, the one
-    # whose smallest eigenvalue crosses 0. At a pitchfork, with the branch they meet on.
-    cols = more if change else lo_cols
-    take = _new_rows(fw, more, less, change) if change else _closest_to_zero(lo_cols, 1)
-    third = _third_branch(fw, more, less, take) if change == 2 and not switch else None
-    involved = take if third is None else np.append(take, third)
-    pose = _pose(fw, switch.columns, np.array([switch.row])) if switch else _pose(fw, cols, take)
-    eig = np.abs(np.asarray(cols["hess_min_eig"], dtype=float)[take])
-    eig = float(eig.max()) if len(eig) else float("nan")
-    near = _nearest(fw, grid, cols, involved)
-    row = {"branches": "+".join(str(x) for x in sorted(grid["branch"][near])), **pose,
-           "hess_min_eig": eig, **base}  # fmt: skip
+    change, born = abs(n_hi - n_lo), n_hi > n_lo
+    span = {"lo": float(b.start[0]), "hi": float(b.start[1])}
     events = []
-    if change:
-        born = n_hi > n_lo
+    for switch, rows in switches:
+        head = {param: switch.value, "refined": b.refined and switch.converged,
+                "bracket": switch.step, **span}  # fmt: skip
+        row = _event_row(fw, grid, more, np.array(rows), np.array(rows), head)
+        row.update(_pose(fw, switch.columns, np.array([switch.row])))
+        names = " and ".join(f"a {k}" for k in sorted(np.asarray(more["kind"])[rows]))
+        verb = ("appears" if born else "disappears") if len(rows) == 1 else (
+            "are born" if born else "meet and vanish")  # fmt: skip
+        what = (
+            f"{names} {verb} at a cable switch ({switch.cable} reaches its free length) as "
+            f"{param} grows past {switch.value:.10g} (the taut and the slack branch end "
+            f"together, the softest Hessian eigenvalue {row['hess_min_eig']:.3g}: no fold)"
+        )
+        events.append({"kind": "cable_switch", **row, "description": what + note})
+    value, bracket = 0.5 * (b.lo + b.hi), b.hi - b.lo
+    head = {param: value, "refined": b.refined, "bracket": bracket, **span}
+    take = _new_rows(fw, more, less, change) if change else _closest_to_zero(lo_cols, 1)
+    if change and not switches:
+        third = _third_branch(fw, more, less, take) if change == 2 else None
+        if third is None and change == 2 and b.estimate is not None:  # a fold: extrapolated
+            head.update({param: b.estimate[0], "bracket": b.estimate[1]})
+        involved = take if third is None else np.append(take, third)
+        row = _event_row(fw, grid, more, take, involved, head)
         if third is not None:  # the third branch: the row nearest the meeting point, each side
-            kinds = np.asarray(grid["kind"], dtype=object)
+            kinds = np.asarray(grid["kind"], dtype=object)[_nearest(fw, grid, more, involved)]
             across = np.asarray(other["kind"], dtype=object)[_nearest(fw, other, more, [third])]
-            kind, head, tail = "pitchfork", _pitchfork_words(kinds[near], across[0], born), ""
+            kind, words, tail = "pitchfork", _pitchfork_words(kinds, across[0], born), ""
         else:
-            kind, head, tail = _kind_words(_kinds(more) - _kinds(less), change, switch, eig, born)
-        what = f"{head} as {param} grows past {value:.10g}{tail}"
-        events.append({"kind": kind, **row, "description": what})
+            kind, words, tail = _kind_words(_kinds(more) - _kinds(less), change, born)
+            cone = _cone(spec, b) if change == 1 else None
+            if cone is not None:  # located where the cone's pull equals k L0, its pose
+                row.update({param: cone.value, "bracket": cone.step, **cone.pose,
+                            "refined": b.refined and cone.converged})  # fmt: skip
+                tail = (
+                    f" at the cone point of spring {cone.spring} (its length 0, its ends "
+                    f"meet): the other elements' pull there equals k L0, the cone a local "
+                    f"maximum of V {'above' if cone.max_above else 'below'} it"
+                )
+        what = f"{words} as {param} grows past {row[param]:.10g}{tail}"
+        events.append({"kind": kind, **row, "description": what + note})
     if s_lo != s_hi:
-        events.append({"kind": "stability_change", **row, "description": f"stable equilibria: "
-                       f"{s_lo} below, {s_hi} above {param} = {value:.10g}"})  # fmt: skip
+        row = {**events[0]} if events else _event_row(fw, grid, lo_cols, take, take, head)
+        what = f"stable equilibria: {s_lo} below, {s_hi} above {param} = {row[param]:.10g}"
+        events.append({**row, "kind": "stability_change", "description": what + note})
     return events
 
 
-def _kind_words(gone: Counter, change: int, switch: Switch | None, eig: float, born: bool):
-    """(kind, what happens, a note) of a count change that is no pitchfork."""
+def _event_row(fw, grid, cols, take, involved, head: dict) -> dict:
+    """An event's branches (of the grid point's rows nearest the `involved` rows of `cols`),
+    pose and softest eigenvalue (of the `take` rows)."""
+    eig = np.abs(np.asarray(cols["hess_min_eig"], dtype=float)[take])
+    near = _nearest(fw, grid, cols, involved)
+    return {"branches": "+".join(str(x) for x in sorted(grid["branch"][near])),
+            **_pose(fw, cols, take), "hess_min_eig": float(eig.max()) if len(eig) else np.nan,
+            **head}  # fmt: skip
+
+
+def _kind_words(gone: Counter, change: int, born: bool) -> tuple[str, str, str]:
+    """(kind, what happens, a note) of a count change that is no pitchfork and no switch."""
     names = " and ".join(f"a {k}" for k in gone.elements()) or "equilibria"
     if change % 2:
         verb = "appears" if born else "disappears"
-    else:
-        verb = "are born" if born else "meet and vanish"
-    if switch is not None:
-        return "cable_switch", f"{names} {verb} where cable {switch.cable} reaches its free " \
-            "length", (f" (the taut and the slack branch end together, a cable switch: the "
-                       f"softest Hessian eigenvalue {eig:.3g}, not singular)")  # fmt: skip
-    if change % 2:
         return "physical_change", f"{names} {verb}", " (a length reaches its limit)"
-    return "fold", f"{names} {verb}", ""
+    return "fold", f"{names} {'are born' if born else 'meet and vanish'}", ""
 
 
 def _pitchfork_words(kinds, across: str, born: bool) -> str:

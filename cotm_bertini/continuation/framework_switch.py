@@ -14,7 +14,7 @@ solve continued from the bracket's lower end, the row followed by its taut set a
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -22,6 +22,7 @@ from .framework import pose_coordinates
 
 SWITCH_GAP = 1e-2  # an appearing row's |d - L0| below this (length units) is tried as a switch
 SECANT_STEPS = 30  # at most this many solves to locate one switch
+NEWTON_STEPS = 20  # Newton steps on a smooth piece of V from a neighbouring pose
 
 
 @dataclass(frozen=True)
@@ -56,38 +57,87 @@ def candidate_cable(fw, cols, rows: np.ndarray, value: float, param: str) -> tup
     return best
 
 
-def locate_switch(spec, solve, start: tuple, other: tuple, cable: str, tol: float):
-    """The Switch on the branch through row `start[2]` of `start[1]` (the solve's columns at
-    parameter start[0]) where `cable` is at its free length, bracketed by `other` (value,
-    columns) where g has the other sign; None if g does not change sign between them or the
-    row cannot be followed. `solve(value)` gives a PointSolution."""
-    fw, param = spec.model, spec.param
-    (pa, cols_a, row), (pb, cols_b) = start, other
-    taut = cols_a["taut_set"][row]
-    key = pose_coordinates(fw, cols_a)[row]
-    gb = _follow(fw, param, cols_b, taut, key, cable, pb)
+def locate_switch(fw, param: str, follow, start: tuple, other: float, tol: float):
+    """The Switch on a branch where `cable` is at its free length: `follow(value)` gives (g,
+    columns, row) of the branch at `value` (g = d - L0 of the cable) or None; `start` = (value,
+    columns, row) of the branch at one end, `other` the value at the other end, where g has the
+    other sign. None if g does not change sign between them or the branch is lost."""
+    (pa, cols_a, row), pb = start, other
+    cable = follow.cable
+    gb = follow(pb)
     ga = _gap(fw, param, cols_a, row, cable, pa)
     if gb is None or np.sign(ga) == np.sign(gb[0]):
         return None
     lo, hi = (pa, ga), (pb, gb[0])  # g changes sign between them
     prev, last = lo, hi
-    found = (cols_b, gb[1])
+    found = gb[1:]
     for _ in range(SECANT_STEPS):
         (p1, g1), (p2, g2) = prev, last
         guess = p2 - g2 * (p2 - p1) / (g2 - g1) if g2 != g1 else None
         a, b = sorted((lo[0], hi[0]))
         value = guess if guess is not None and a < guess < b else 0.5 * (a + b)
-        cols = solve(value).columns
-        got = _follow(fw, param, cols, taut, key, cable, value)
+        got = follow(value)
         if got is None:
             return None
-        g, r = got
-        found, step = (cols, r), abs(value - p2)
+        g, found = got[0], got[1:]
+        # The accuracy: the next secant step (where d - L0 is linear in the parameter, as on a
+        # branch that does not depend on it, the first step lands on the switch).
+        step = abs(g * (value - p2) / (g - g2)) if g != g2 else abs(value - p2)
         prev, last = last, (value, g)
         lo, hi = ((value, g), hi) if np.sign(g) == np.sign(lo[1]) else (lo, (value, g))
         if g == 0.0 or step <= tol:
             return Switch(cable, value, step, True, abs(g), *found)
     return Switch(cable, last[0], abs(last[0] - prev[0]), False, abs(last[1]), *found)
+
+
+@dataclass(frozen=True)
+class Follower:
+    """follow(value) -> (g, columns, row) | None: the branch through row `row` of `cols` (taut
+    set and pose) at another value of the parameter, g = d - L0 of `cable` on it. On a circle or
+    torus, Newton on that taut set's smooth piece of V from the row's angles (the branch goes on
+    past the switch, where it is no equilibrium: the real route reports none there); elsewhere
+    the row of that taut set nearest in pose in a full solve (`solve(value)`)."""
+
+    fw: object
+    param: str
+    cols: dict
+    row: int
+    cable: str
+    solve: object
+
+    def __call__(self, value: float):
+        from ..backends.real_route import covers
+
+        taut = self.cols["taut_set"][self.row]
+        key = pose_coordinates(self.fw, self.cols)[self.row]
+        if covers(self.fw):
+            cols = self.solve(value).columns
+        else:
+            cols = _piece(self.fw, self.param, value, taut, self.cols, self.row)
+        got = _follow(self.fw, self.param, cols, taut, key, self.cable, value)
+        return None if got is None else (got[0], cols, got[1])
+
+
+def _piece(fw, param: str, value: float, taut: str, cols: dict, row: int) -> dict:
+    """The columns of the one solution of taut set `taut`'s system at `value` that Newton
+    reaches from the body angles of row `row` of `cols` (physical or not)."""
+    from ..analysis.framework_classify import framework_columns
+    from ..analysis.refine import newton_refine
+    from ..backends.real_route import TorusFramework
+    from ..model.framework.compiled import framework_system
+    from ..model.framework.units import normalized_slots, units
+
+    here = fw.replace(**{param: value})
+    land = TorusFramework(here)
+    on = taut.split() if isinstance(taut, str) else []
+    names = tuple(c.name for c in fw.cables if c.name in on)
+    angles = np.radians([[float(cols[f"{b}.angle_deg"][row]) for b in land.bodies]])
+    start = land.endpoints_of(names, angles)
+    fs = framework_system(here, names)
+    slots_n = normalized_slots(here)
+    system = fs.ps.instantiate([slots_n[n] for n in fs.ps.parameters])
+    x, _ = newton_refine(system, start.points, NEWTON_STEPS)
+    return framework_columns(here, fs, replace(start, points=x), units(here))
 
 
 def _gap(fw, param: str, cols, row: int, cable: str, value: float) -> float:

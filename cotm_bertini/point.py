@@ -285,18 +285,27 @@ def _solve_real(fw, settings: Settings, tolerances: Tolerances, t: Timings) -> P
     from .analysis.framework_checks import completeness, framework_counts, order_rows
     from .analysis.framework_continua import absorb, continuum_record, find_continua
     from .backends.boxes import MIN_WIDTH, SHORT, search
-    from .backends.real_route import TorusFramework, critical_seeds
-    from .model.framework.units import units
+    from .backends.real_route import TorusFramework, critical_seeds, fresh_points
+    from .model.framework.compiled import check_terms
+    from .model.framework.units import normalized_slots, units
 
     unit = units(fw)
     sets, pruned = split_taut_sets(fw)
     with t.stage("derive"):
         land = TorusFramework(fw)
-        _ = land.hessian_sets  # derived (or loaded) here, not inside the search's clock
+        target = normalized_slots(fw)
+        for taut, fs in land.hessian_sets:  # derived (or loaded) here, not in the search's clock
+            if taut in sets:
+                check_terms(fw, fs, target)  # a degenerate equation: refused, not searched
     with t.stage("solve"):
         found = search(land, SHORT, MIN_WIDTH, max_seconds=settings.timeout,
                        label=f"real search of {fw.name}")  # fmt: skip
-        seeds = critical_seeds(land, found.undecided)
+        # Critical points the search could not prove: in boxes left undecided (a continuum
+        # passes there) or set aside next to a cone point (a saddle leaves the cone point as
+        # the other elements' pull there passes k L0): found by Newton, not proved unique.
+        seeds = fresh_points(np.vstack([critical_seeds(land, found.undecided),
+                                        critical_seeds(land, found.set_aside_boxes)]),
+                             found.roots)  # fmt: skip
         groups = land.endpoints(np.vstack([found.roots, seeds]))
     report: dict = {" ".join(taut) or "none": {"excluded": True, "pruned": "bound smoothing",
                     "note": why.note()} for taut, why in pruned.items()}  # fmt: skip
@@ -309,6 +318,7 @@ def _solve_real(fw, settings: Settings, tolerances: Tolerances, t: Timings) -> P
     morse_bott = all(c.index is not None for c in continua)
     search_info = real_search_info(found, unit[0], along_continua(land, found, continua),
                                    morse_bott)  # fmt: skip
+    search_info["found_by_newton"] = len(seeds)
     warnings = tuple(search_info["warnings"] + checks["warnings"])
     counts = {**framework_counts(table, report, continua), "boxes": found.boxes}
     engine = {"flavour": "real", "path": "branch and bound (backends.boxes)", "version": ""}

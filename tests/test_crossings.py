@@ -114,7 +114,7 @@ def test_unresolved_crossings_make_the_framework_run_incomplete(tmp_path):
     import shutil
 
     toml = ROOT / "examples" / "zeeman_cables.toml"
-    args = ["solve", "--framework", str(toml), "--no-plots", "--no-cache"]
+    args = ["solve", "--framework", str(toml), "--no-plots", "--no-cache", "--route", "complex"]
     r = run_cli(*args, "--out", str(tmp_path / "a"))
     assert r.returncode == 0, r.stderr
     first = json.loads((tmp_path / "a" / "latest" / "run.json").read_text())

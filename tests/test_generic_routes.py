@@ -147,7 +147,9 @@ def test_params_takes_the_seed_and_route_of_the_first_solve(tmp_path):
     mechanism (no cost statement) they are refused in one line, not ignored."""
     env = {"COTM_CACHE": str(tmp_path)}
     zeeman = str(ROOT / "examples" / "zeeman.toml")
-    mono = run_cli("params", "--framework", zeeman, "--seed", "3", env=env)
+    real = run_cli("params", "--framework", zeeman, "--seed", "3", env=env)
+    assert real.returncode == 0 and "zeeman: the real route" in real.stdout, real.stderr
+    mono = run_cli("params", "--framework", zeeman, "--seed", "3", "--route", "complex", env=env)
     assert mono.returncode == 0, mono.stderr
     assert "first solve of zeeman (seed 3)" in mono.stdout and "by monodromy" in mono.stdout
     total = run_cli("params", "--framework", zeeman, "--generic", "total-degree", env=env)

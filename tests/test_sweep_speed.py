@@ -177,8 +177,9 @@ def test_branches_and_events_from_columns_equal_those_from_a_dataframe(fold_swee
     # What the folder holds is what was found.
     on_disk = pd.read_csv(fold_sweep.folder / "events.csv")
     np.testing.assert_allclose(on_disk["L01"], events["L01"], rtol=0, atol=0)
-    assert sorted(os.listdir(fold_sweep.folder)) == [
-        "columns.md", "events.csv", "points.bin", "run.json", "sweep.csv", "sweep.json",
+    assert sorted(os.listdir(fold_sweep.folder)) == [  # .events.json: the refined events kept
+        ".events.json", "columns.md", "events.csv", "points.bin", "run.json", "sweep.csv",
+        "sweep.json",
     ]  # fmt: skip
 
 

@@ -270,6 +270,17 @@ def critical_seeds(land: TorusFramework, boxes: np.ndarray, most: int = 64) -> n
     return x[np.isfinite(g).all(axis=1) & (np.abs(g).max(axis=1) < 1e-10)]
 
 
+def fresh_points(points: np.ndarray, known: np.ndarray, apart: float = 1e-8) -> np.ndarray:
+    """The points (R, n angles) that are neither within `apart` (rad, on the torus) of a
+    `known` one nor of an earlier one of their own."""
+    kept: list[np.ndarray] = []
+    for x in points:
+        others = list(known) + kept
+        if all(np.abs((x - y + np.pi) % (2 * np.pi) - np.pi).max() > apart for y in others):
+            kept.append(x)
+    return np.array(kept).reshape(-1, known.shape[1] if known.ndim == 2 else points.shape[1])
+
+
 @lru_cache(maxsize=128)
 def real_equilibria(fw: Framework) -> tuple[dict[tuple[str, ...], Endpoints], BoxSearch]:
     """Every real critical point of V (the search's default settings), as endpoints by taut set

@@ -38,6 +38,7 @@ BATCH = 4096  # boxes a step: large enough that numpy's loops, not Python, set t
 KRAWCZYK_WIDTH = 0.2  # radians: wider boxes are split, not tested (the test rarely decides them)
 SHORT = 1e-3  # length units: springs shorter than this are set aside (V has a cone point at 0)
 MIN_WIDTH = 1e-4  # radians: the smallest box away from a critical point
+NEAR_CONE = 10.0  # undecided where a spring may be shorter than this times SHORT: set aside
 NEAR_CONDITION = 1e10  # a critical point worth splitting below MIN_WIDTH for is no worse than this
 ROOT_FLOOR = 1e-10  # radians: boxes are not split below this, whatever a spring's length
 
@@ -167,10 +168,7 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, acc: dict)
         smooth = ~(dd.lo <= short * short).any(axis=1)
         aside = (dd.hi < short * short).any(axis=1) | (~smooth & (width <= min_width))
         if aside.any():
-            acc["aside"] += int(aside.sum())
-            acc["aside_boxes"].append(np.hstack([lo[aside], hi[aside]]))
-            longest = np.sqrt(np.maximum(dd.hi[aside].min(axis=1), 0.0)).max()
-            acc["bound"] = max(acc["bound"], float(longest))
+            _set_aside(acc, lo[aside], hi[aside], dd.hi[aside])
         floor = _floor(dd, min_width)
     decided = np.zeros(len(lo), dtype=bool)
     found: tuple[list, list] = ([], [])
@@ -194,8 +192,24 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, acc: dict)
     if small.any():  # a root in or next to the box: split on (Krawczyk wants small boxes there)
         near = _root_near(land, lo[small], hi[small])
         small[np.flatnonzero(small)[near & (width[small] > ROOT_FLOOR)]] = False
+    if small.any() and dd.lo.shape[1]:
+        # Next to a cone point the 1/d terms keep the enclosures too wide to decide: such a
+        # box is set aside as the short ones are (its spring bound counted), not undecided.
+        cone = small & (dd.lo < (NEAR_CONE * short) ** 2).any(axis=1)
+        if cone.any():
+            _set_aside(acc, lo[cone], hi[cone], dd.hi[cone])
+            small &= ~cone
     left = np.hstack([lo[small], hi[small]])
     return _split(lo[rest & ~small], hi[rest & ~small]), found, left
+
+
+def _set_aside(acc: dict, lo: np.ndarray, hi: np.ndarray, dd_hi: np.ndarray) -> None:
+    """Boxes set aside at a cone point: counted, kept, and their spring bound taken (in each,
+    some spring with a free length is at most sqrt(min dd_hi) long)."""
+    acc["aside"] += len(lo)
+    acc["aside_boxes"].append(np.hstack([lo, hi]))
+    longest = np.sqrt(np.maximum(dd_hi.min(axis=1), 0.0)).max()
+    acc["bound"] = max(acc["bound"], float(longest))
 
 
 def _root_near(land: BoxLandscape, lo: np.ndarray, hi: np.ndarray, steps: int = 8) -> np.ndarray:

@@ -106,8 +106,8 @@ def main() -> None:
     rows = [_row(n) for n in EXAMPLES if n not in args.skip]
     frame = pd.DataFrame(rows)
     show("real route: first solve against a later one, the search's boxes", frame,
-         {"first_solve_s": "{:.2f}", "later_solve_s": "{:.2f}", "first_over_later": "{:.2f}",
-          "search_cpu_s": "{:.3f}", "us_per_box": "{:.1f}"})  # fmt: skip
+         {"first_solve_s": ".2f", "later_solve_s": ".2f", "first_over_later": ".2f",
+          "search_cpu_s": ".3f", "us_per_box": ".1f"})  # fmt: skip
     write_csv(frame, "real_route")
     show(
         "the paper's case 3: built-in model (Bertini) and cotm.toml (real route)",

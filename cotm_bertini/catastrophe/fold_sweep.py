@@ -284,6 +284,8 @@ def _turning_folds(cs: CurveSystem, spec, branches: list[Traced]) -> tuple[list,
     and refined by Newton on the fold system; with counts of the turns that are
     relaxed folds (every force density 0: the fold system is singular there, and the relaxed
     folds have their own) and of those that could not be located or refined."""
+    if cs.kind == "switch":
+        return _switch_points(cs, spec, branches)
     eqs, win, fold_eqs = _branch_equations(cs, spec), _line_window(spec), curve_equations(cs)
     along = np.array(spec[2:]) / np.hypot(*spec[2:])
     forces = [k for k, v in enumerate(cs.variables) if v.startswith("w_")]
@@ -297,6 +299,28 @@ def _turning_folds(cs: CurveSystem, spec, branches: list[Traced]) -> tuple[list,
                 continue
             hit = None if turn is None else _line_newton(fold_eqs, turn, spec)
             if hit is None or np.abs(hit[0] - turn).max() > SAME * (1 + np.abs(turn).max()):
+                counts["unrefined"] += 1
+            elif 0.0 <= hit[1] <= 1.0 and not any(
+                np.abs(hit[0] - f).max() <= SAME * (1 + np.abs(f).max()) for f in found
+            ):
+                found.append(hit[0])
+    return found, counts
+
+
+def _switch_points(cs: CurveSystem, spec, branches: list[Traced]) -> tuple[list, dict]:
+    """The switch points of the branches (a switch system: the equilibria and d_c = L0_c):
+    where its last equation changes sign between two points of a branch, refined by Newton on
+    the switch system with (mx, my) held to the line."""
+    switch_eqs = curve_equations(cs)
+    found, counts = [], {"turns": 0, "relaxed": 0, "unrefined": 0}
+    for b in branches:
+        pts = np.vstack([b.points, b.points[:1]]) if b.closed else b.points
+        gap = np.array([cs.trace.value_and_jacobian(z)[0][0][-1].real for z in pts])
+        for i in np.flatnonzero(gap[:-1] * gap[1:] < 0):
+            counts["turns"] += 1
+            s = gap[i] / (gap[i] - gap[i + 1])
+            hit = _line_newton(switch_eqs, pts[i] + s * (pts[i + 1] - pts[i]), spec)
+            if hit is None:
                 counts["unrefined"] += 1
             elif 0.0 <= hit[1] <= 1.0 and not any(
                 np.abs(hit[0] - f).max() <= SAME * (1 + np.abs(f).max()) for f in found

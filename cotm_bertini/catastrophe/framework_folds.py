@@ -55,6 +55,7 @@ from ..model.framework.folds import (
 )
 from ..model.framework.spec import Framework
 from ..model.framework.units import normalized_slots, units
+from ..point import framework_route
 from ..progress import Progress, say
 from ..settings import Settings, Tolerances
 from .curve_trace import Traced, Window, trace, turning_point
@@ -250,6 +251,8 @@ def _find(fw: Framework, cs: CurveSystem, axes, settings, seeds: str, work: _Wor
     groups = _groups(cs, settings.seed)
     paths = bezout_number(_degrees(cs, settings.seed, groups), [len(g) for g in groups])
     route = seeds if seeds != "auto" else "witness" if paths <= WITNESS_MAX_PATHS else "sweep"
+    if seeds == "auto" and framework_route(fw, settings) == "real":
+        route = "sweep"  # each crossing's real equilibria by the real route: no witness set
     if cs.kind == "relaxed":
         route = "witness"  # module docstring: a sweep cannot tell relaxed folds from others
     info: dict = {"seed_route": route, "witness_paths": paths}

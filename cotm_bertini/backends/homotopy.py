@@ -16,8 +16,9 @@ import hashlib
 import json
 import time
 from collections.abc import Iterator, Mapping
-from contextlib import contextmanager, nullcontext
+from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -31,7 +32,7 @@ from ..progress import duration, say
 from ..settings import Settings
 from ..versions import bertini2_version
 from .endpoints import Endpoints
-from .path_progress import expected, generic_report, remember, watched
+from .path_progress import expected, generic_report, remember
 from .render import render_parameter_homotopy, render_system
 from .start_system import (
     gamma_homotopy_text,
@@ -43,6 +44,11 @@ DOUBLE_FINAL_TOLERANCE = 1e-8
 DOUBLE_MAX_STEPS = 2000
 GENERIC_MAX_STEPS = 20000  # steps a path of a framework's generic solve may take
 SECOND_START = 7919  # seed offset of the independent second generic set
+ENDGAME_T = (
+    0.1  # Bertini's endgame boundary: on a patch, a path at infinity before this is retracked
+)
+PATCH_SEED = 2028  # Bertini's random patch of every projective homotopy (the same on every run)
+LOCAL_CHUNK = 64  # paths a Bertini call of a generic solve in this process (progress between)
 ANNOUNCE_SECONDS = 2.0  # a generic solve expected to take longer is announced on stderr
 CHUNKS_PER_WORKER = 4  # a split generic solve sends this many chunks of paths per Dask worker
 BERTINI_MAX_NORM = 1e5  # Bertini's default security max norm (a larger norm counts as infinite)
@@ -280,10 +286,7 @@ def _solve_generic(
     paths, rate, _ = expected(ps, groups)
     t0 = time.perf_counter()
     with generic_report(seed, paths, paths * rate >= ANNOUNCE_SECONDS) as report:
-        if scheduler is None:
-            ends, route = _bertini_solve(system, seed, groups, report)
-        else:
-            ends, route = _split_solve(system, seed, groups, scheduler, report)
+        ends, route = _own_solve(system, seed, groups, scheduler, report)
     seconds = time.perf_counter() - t0
     codes, finite_flags, singular, pts = ends
     # The next solve of this system (the second seed) starts from this measured rate.
@@ -304,81 +307,68 @@ def _solve_generic(
     )
 
 
-def _bertini_solve(system, seed: int, groups, report=None) -> tuple[tuple, dict]:
-    """Every path of Bertini's own start system (multihomogeneous with `groups`, else total
-    degree) in one ZeroDimSolver call: (codes, finite, singular, points), the route record.
-    `report` (a progress.Progress) advances as each path finishes."""
-    bertini = _bertini()
-    from bertini import nag_algorithm as na
-
-    bertini.random.set_random_seed(seed)
-    cpu = time.process_time()
-    solver = na.ZeroDimSolver(bertini.parse.system(render_system(system, groups)))
-    if groups:
-        # A framework's start system can send a few paths crawling for ever; a path cut short
-        # shows up as a count the second generic set (another seed) does not confirm.
-        solver.set(max_num_steps=GENERIC_MAX_STEPS)
-    with watched(solver, report) if report is not None else nullcontext():
-        solver.solve(show_progress=False)  # our report, not Bertini's own bar
-    meta, pts = solver.solution_metadata(), solver.all_solutions()
-    points = _end_points(pts, len(system.variables))
-    if groups:
-        # Bertini orders the variables group by group; a merged group breaks our order.
-        declared = [v for g in groups for v in g]
-        points = points[:, [declared.index(v) for v in system.variables]]
-    ends = (
-        [_code(m) for m in meta],
-        [bool(m.is_finite) for m in meta],
-        [is_singular(m) for m in meta],
-        points,
-    )
-    start = "multihomogeneous" if groups else "total-degree"
-    route = {
-        "method": f"bertini {start} start (ZeroDimSolver), one call",
-        "cpu_seconds": round(time.process_time() - cpu, 3),
-        "failed_paths": _failed(ends[0]),
-    }
-    return ends, route
-
-
-def _split_solve(system, seed: int, groups, scheduler: str, report=None) -> tuple[tuple, dict]:
-    """Every path of our own linear-product start system (backends.start_system), tracked in
-    chunks on the Dask workers at `scheduler`: (codes, finite, singular, points), the route.
-    `report` (a progress.Progress) advances as each chunk comes back."""
-    from .dask_jobs import run_jobs
-
+def own_start(system, groups, seed: int) -> tuple:
+    """(start, (homotopy text, target text)): `seed`'s random linear-product start system of
+    `system` for `groups` (None: total degree) and the gamma-trick homotopy to `system`, both
+    texts declaring the start's variable groups (points in `start.declared` order)."""
     lp = linear_product_start(system, groups, seed)
     gamma = np.exp(2j * np.pi * np.random.default_rng((seed, 1)).random())
-    texts = (gamma_homotopy_text(system, lp, gamma), render_system(system))
+    names = [[system.variables[k] for k in g] for g in lp.groups]
+    return lp, (gamma_homotopy_text(system, lp, gamma), render_system(system, names))
+
+
+def _own_solve(system, seed: int, groups, scheduler=None, report=None) -> tuple[tuple, dict]:
+    """Every path of our own linear-product start system (backends.start_system) on a
+    multiprojective patch, in chunks (`track_chunk`): in this process, or on the Dask workers at
+    `scheduler`: (codes, finite, singular, points), the route record. `report` (a
+    progress.Progress) advances as each chunk comes back."""
+    from .dask_jobs import run_jobs
+
+    lp, texts = own_start(system, groups, seed)
     total, starts, workers = lp.count(), [], []
+
+    def job(points: np.ndarray, **more) -> dict:
+        return {"texts": texts, "points": points[:, lp.declared], **more}
 
     def jobs(n: int) -> list[dict]:
         workers.append(n)
         starts.extend(lp.chunks(max(1, -(-total // (CHUNKS_PER_WORKER * n)))))
-        return [{"texts": texts, "points": c} for c in starts]
+        return [job(c) for c in starts]
 
+    def run(batch) -> Iterator[tuple[int, dict]]:
+        if scheduler is not None:
+            return run_jobs(track_chunk, batch, scheduler)
+        return ((k, track_chunk({**j, "threads": None})) for k, j in enumerate(batch))
+
+    batch = jobs
+    if scheduler is None:  # chunks for the progress lines; Bertini's threads share each one
+        workers.append(1)
+        starts.extend(lp.chunks(LOCAL_CHUNK))
+        batch = [job(c) for c in starts]
     done = {}
-    for k, chunk in run_jobs(track_chunk, jobs, scheduler):
+    for k, chunk in run(batch):
         done[k] = chunk
         if report is not None:
             report.update(len(chunk["codes"]))
     chunks = [done[k] for k in range(len(done))]
     ends = [[x for c in chunks for x in c[f]] for f in ("codes", "finite", "singular")]
-    pts = np.vstack([c["points"] for c in chunks])
+    back = np.argsort(lp.declared)  # Bertini's coordinates are group by group
+    pts = np.vstack([c["points"] for c in chunks])[:, back]
     twins, again_cpu = _twins(*ends, pts), 0.0
     if twins:  # one path jumped onto another's root in double precision: both again, in AMP
-        job = {"texts": texts, "points": np.vstack(starts)[twins], "mptype": "adaptive"}
-        again = next(iter(run_jobs(track_chunk, [job], scheduler)))[1]
+        again = next(iter(run([job(np.vstack(starts)[twins], mptype="adaptive")])))[1]
         again_cpu = again["cpu_seconds"]
         for k, i in enumerate(twins):
             for f, col in zip(("codes", "finite", "singular"), ends, strict=True):
                 col[i] = again[f][k]
-            pts[i] = again["points"][k]
+            pts[i] = again["points"][k][back]
         for i in _twins(*ends, pts):  # still together: a multiple root, as ZeroDimSolver says
             ends[2][i] = True
+    where = f"on {scheduler}" if scheduler else "in this process"
     route = {
         "method": f"own {'multihomogeneous' if groups else 'total-degree'} linear-product "
-        f"start, split in {len(chunks)} chunks on {scheduler}",
+        f"start on a projective patch, double then adaptive precision, {len(chunks)} chunks "
+        f"{where}",
         "scheduler": scheduler,
         "workers": workers[0],
         "chunks": len(chunks),
@@ -425,61 +415,117 @@ def _end_points(pts, n: int) -> np.ndarray:
     return out
 
 
-def _track_texts(texts: tuple[str, str], points: np.ndarray, mptype: str) -> dict:
-    """The homotopy texts[0] (target texts[1]) tracked from `points` on one thread (the
-    parallelism is the cluster's), with the step caps of track and the generic solve."""
-    bertini = _bertini()
-    from bertini import nag_algorithm as na
-
-    hom, target = (bertini.parse.system(text) for text in texts)
-    solver = na.HomotopySolver(hom, list(points), target, mptype=mptype)
-    if mptype == "double":  # as in track: give up early, adaptive precision redoes it
-        solver.set(final_tolerance=DOUBLE_FINAL_TOLERANCE, max_num_steps=DOUBLE_MAX_STEPS)
-    else:
-        solver.set(max_num_steps=GENERIC_MAX_STEPS)
-    solver.set(num_threads=1)
-    solver.solve(show_progress=False)
-    meta, pts = solver.solution_metadata(), solver.all_solutions()
-    return {
-        "codes": [_code(m) for m in meta],
-        "finite": [bool(m.is_finite) for m in meta],
-        "singular": [is_singular(m) for m in meta],
-        "points": _end_points(pts, points.shape[1]),
-    }
-
-
 def track_chunk(job: dict) -> dict:
-    """One chunk of a split generic solve (a Dask task: plain data in, plain data out): the
-    gamma-trick homotopy `job["texts"]` tracked from `job["points"]` in double precision, and
-    every path that does not end at a nonsingular finite point (or that meets another) again
-    in adaptive precision, as `track` does (`job["mptype"] = "adaptive"`: all in AMP)."""
-    t0, cpu = time.perf_counter(), time.process_time()  # one task at a time a worker process
+    """One chunk of a generic solve (a Dask task: plain data in, plain data out): the
+    gamma-trick homotopy `job["texts"]` tracked from `job["points"]` on a projective patch by
+    double_then_adaptive (`job["mptype"] = "adaptive"`: all in AMP); `job["threads"]`:
+    Bertini's threads (None: its default, every core; 1 on a cluster, whose workers are the
+    parallelism)."""
+    t0 = time.perf_counter()  # one task at a time a worker process
     points = np.asarray(job["points"], dtype=complex)
+    options = {
+        "projective": True,
+        "max_norm": BERTINI_MAX_NORM,
+        "num_threads": job.get("threads", 1),
+    }
     if job.get("mptype") == "adaptive":
-        out, redo = _track_texts(job["texts"], points, "adaptive"), []
+        cpu = time.process_time()
+        out = tracked_paths(job["texts"], points, "adaptive", options)
+        out.update(retracked_adaptive=0, cpu_seconds=time.process_time() - cpu)
     else:
-        out = _track_texts(job["texts"], points, "double")
-        fields = [out[f] for f in ("codes", "finite", "singular")]
-        redo = sorted(
-            {
-                k
-                for k, (c, f, s) in enumerate(zip(*fields, strict=True))
-                if c != _SUCCESS or not f or s
-            }
-            | set(_twins(*fields, out["points"]))
-        )
+        out = double_then_adaptive(job["texts"], points, options)
+    return {**out, "seconds": time.perf_counter() - t0}
+
+
+def double_then_adaptive(
+    texts: tuple[str, str], points: np.ndarray, options: dict, singular_ok: bool = False
+) -> dict:
+    """The homotopy texts[0] (target texts[1]) from `points` in double precision, then in
+    adaptive precision every path that did not end at a finite point, that met another or
+    (unless `singular_ok`: a caller to whom a singular endpoint is no root it keeps, whose
+    retrack costs ~0.15 s for the same point) that ended singular. On a projective patch
+    (`options["projective"]`) a path that reached infinity inside the endgame (t < ENDGAME_T)
+    is not tracked again: a root escaping as t -> 0 grows like t^-a, past the max norm only
+    near t = 0, while a path past it earlier may be a finite root's (in affine coordinates
+    such a path fails in double precision instead, and its adaptive retrack costs 0.3-1 s:
+    the X-module's total-degree paths, monodromy's final homotopy). Every other failed path is
+    tracked again (without that the double pendulum's monodromy lost 550 of 1,700 paths)."""
+    cpu = time.process_time()
+    out = tracked_paths(texts, points, "double", options)
+    fields = [out[f] for f in ("codes", "finite", "singular")]
+    patch = bool(options.get("projective"))
+    times = zip(out["codes"], out["times"], strict=True)
+    away = [patch and c in INFINITE_CODES and t < ENDGAME_T for c, t in times]
+    redo = {
+        k
+        for k, (c, f, sing) in enumerate(zip(*fields, strict=True))
+        if (c != _SUCCESS or not f or (sing and not singular_ok)) and not away[k]
+    }
+    redo = sorted(redo | set(_twins(*fields, out["points"])))
     if redo:
-        again = _track_texts(job["texts"], points[redo], "adaptive")
+        again = tracked_paths(texts, points[redo], "adaptive", options)
         for f in ("codes", "finite", "singular"):
             for k, i in enumerate(redo):
                 out[f][i] = again[f][k]
         out["points"][redo] = again["points"]
+    return {**out, "retracked_adaptive": len(redo), "cpu_seconds": time.process_time() - cpu}
+
+
+def tracked_paths(texts: tuple[str, str], points: np.ndarray, mptype: str, options: dict) -> dict:
+    """One HomotopySolver call (one thread unless `options["num_threads"]` says otherwise,
+    None: Bertini's default) with the step caps of track, each path's outcome the code it
+    stopped with (_code) and the t it stopped at; `options["projective"]`: on a patch
+    (parsed_system); "predictor" by name; the rest Bertini's settings."""
+    _bertini()  # recording off, before the import
+    from bertini import nag_algorithm as na
+    from bertini import tracking
+
+    options = {"num_threads": 1, **options}
+    if options["num_threads"] is None:
+        del options["num_threads"]
+    if "predictor" in options:  # by name here: the enum needs the module
+        options["predictor"] = getattr(tracking.Predictor, options["predictor"])
+    hom = parsed_system(texts[0], options.pop("projective", False))
+    solver = na.HomotopySolver(hom, list(points), parsed_system(texts[1]), mptype=mptype)
+    if mptype == "double":
+        solver.set(final_tolerance=DOUBLE_FINAL_TOLERANCE, max_num_steps=DOUBLE_MAX_STEPS)
+    else:
+        solver.set(max_num_steps=GENERIC_MAX_STEPS)
+    solver.set(**options)
+    solver.solve(show_progress=False)
+    meta = solver.solution_metadata()
     return {
-        **out,
-        "retracked_adaptive": len(redo),
-        "seconds": time.perf_counter() - t0,
-        "cpu_seconds": time.process_time() - cpu,
+        "codes": [_code(m) for m in meta],
+        "finite": [bool(m.is_finite) for m in meta],
+        "singular": [is_singular(m) for m in meta],
+        "times": [abs(complex(m.final_time_used)) for m in meta],
+        "points": _end_points(solver.all_solutions(), points.shape[1]),
     }
+
+
+@lru_cache(maxsize=16)
+def parsed_system(text: str, projective: bool = False):
+    """Bertini's parse of a system text, kept: a monodromy edge is tracked again and again, and
+    a parse of case 3's homotopy costs 3 ms (11 % of a run, measured); a solver does not change
+    the system it tracks (same endpoints from a kept parse and a fresh one, checked).
+
+    `projective`: homogenized (one homogenizing variable per variable group: multiprojective)
+    on a patch drawn from a fixed seed (Bertini's own homogenization; its solver dehomogenizes
+    the endpoints), for homotopies whose paths mostly go to infinity: in affine coordinates
+    double precision fails on them near t = 0 (296 of the prism's 343 paths of monodromy's
+    final homotopy) and each costs a 0.27 s adaptive retrack (83 s of a 122 s run); on a patch
+    they end at infinity in double precision (that final homotopy 3.2 s, the same 22 roots)."""
+    bertini = _bertini()
+    system = bertini.parse.system(text)
+    if not projective:
+        return system
+    from bertini import system as bsys
+
+    bertini.random.set_random_seed(PATCH_SEED)  # the same patch on every run
+    system = bsys.clone(system)
+    system.homogenize()
+    system.auto_patch()
+    return system
 
 
 def route_record(sets: list[GenericSet], scheduler: str | None) -> dict:

@@ -10,6 +10,7 @@ evaluated here with numpy."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from conftest import ROOT, same_sets
 from test_progress import bezout
 
@@ -129,3 +130,29 @@ def test_projective_total_degree_solve_finds_the_affine_solves_roots(monkeypatch
     ok = [i for i, c in enumerate(affine["codes"]) if c == "Success" and affine["finite"][i]]
     assert len(ok) == 6 and same_sets(affine["points"][ok], gs.points)
     assert gs.route["retracked_adaptive"] < affine["retracked_adaptive"]
+
+
+@pytest.mark.slow
+def test_xmodule_complex_first_solve_equals_an_independent_newton_search(monkeypatch, tmp_path):
+    """The X-module's first solve by the complex route (an empty cache; about 40 CPU s, every
+    taut set by total degree on the patch, two seeds agreeing): status ok and the 12 physical
+    rows of the Newton search on the energy written in test_real_route (`make stress`)."""
+    from test_real_route import MATCH_DEG, _pair, _x_reference
+
+    from cotm_bertini.model.framework import compiled
+
+    monkeypatch.setenv("COTM_CACHE", str(tmp_path))
+    monkeypatch.setattr(compiled, "_LOADED", {})
+    monkeypatch.setattr(homotopy, "_LOADED", {})
+    theta, V, eig = _x_reference()
+    res = cb.solve(cb.Framework.from_toml(XMODULE), route="complex", cache=False)
+    assert res.status == "ok", res.warnings
+    for record in res.record["details"]["taut_sets"].values():
+        sets = record["generic_route"]["generic_sets"]
+        assert len(sets) == 2 and all(g["method"].startswith("own multihomogeneous") for g in sets)
+    rows = res.physical
+    pick, gap = _pair(rows[["bar1.angle_deg", "bar2.angle_deg"]].to_numpy(float),
+                      np.degrees(theta))  # fmt: skip
+    assert len(rows) == 12 and gap.max() < MATCH_DEG
+    np.testing.assert_allclose(rows.iloc[pick]["energy"], V, atol=1e-10)
+    assert int(res.counts["stable"]) == int((eig > 0).all(axis=1).sum())

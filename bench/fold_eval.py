@@ -83,7 +83,7 @@ def _paths(ps, groups, count: int, seed: int) -> dict:
     """Seconds a path of the witness homotopy on `count` start points, both forms, and the
     largest difference of their finite ends; then a parameter homotopy from those ends to
     another random complex line, both forms, and the largest difference of its ends."""
-    from cotm_bertini.backends.homotopy import _SUCCESS, _track_texts
+    from cotm_bertini.backends.homotopy import _SUCCESS, tracked_paths
     from cotm_bertini.backends.render import render_parameter_homotopy, render_system
     from cotm_bertini.backends.start_system import gamma_homotopy_text, linear_product_start
 
@@ -91,12 +91,14 @@ def _paths(ps, groups, count: int, seed: int) -> dict:
     line0, line1 = (dict(zip(ps.parameters, _crand(rng, 4), strict=True)) for _ in range(2))
     sysx = ps.instantiate([line0[n] for n in ps.parameters])
     lp = linear_product_start(sysx, groups, seed)
-    starts, gamma = next(lp.chunks(count)), np.exp(2j * np.pi * rng.random())
+    starts, gamma = next(lp.chunks(count))[:, lp.declared], np.exp(2j * np.pi * rng.random())
+    names = [[sysx.variables[k] for k in g] for g in lp.groups]  # the homotopy's groups
     out, ends = {}, {}
     for label, system in (("before", dataclasses.replace(sysx, structured=None)), ("after", sysx)):
         t0 = time.perf_counter()
-        res = _track_texts((gamma_homotopy_text(system, lp, gamma), render_system(system)),
-                           starts, "double")  # fmt: skip
+        res = tracked_paths((gamma_homotopy_text(system, lp, gamma),
+                             render_system(system, names)), starts, "double", {})  # fmt: skip
+        res["points"] = res["points"][:, np.argsort(lp.declared)]
         out[f"s_path_{label}"] = (time.perf_counter() - t0) / count
         ends[label] = res
     ok = [i for i in range(count) if all(ends[w]["codes"][i] == _SUCCESS and
@@ -117,7 +119,7 @@ def _paths(ps, groups, count: int, seed: int) -> dict:
         for label, (form, tgt) in forms.items():
             t0 = time.perf_counter()
             texts = (render_parameter_homotopy(form, line0, line1), render_system(tgt))
-            moved[label] = _track_texts(texts, pts["after"], "double")
+            moved[label] = tracked_paths(texts, pts["after"], "double", {})
             out[f"s_param_path_{label}"] = (time.perf_counter() - t0) / len(ok)
         fin = [i for i in range(len(ok)) if all(moved[w]["finite"][i] for w in moved)]
         a, b = (moved[w]["points"][fin] for w in ("before", "after"))

@@ -50,14 +50,10 @@ def _run(system, groups, paths: int, workers: int) -> dict:
     from distributed import LocalCluster
 
     from cotm_bertini.backends.dask_jobs import run_jobs
-    from cotm_bertini.backends.homotopy import track_chunk
-    from cotm_bertini.backends.render import render_system
-    from cotm_bertini.backends.start_system import gamma_homotopy_text, linear_product_start
+    from cotm_bertini.backends.homotopy import own_start, track_chunk
 
-    lp = linear_product_start(system, groups, 1)
-    gamma = np.exp(2j * np.pi * np.random.default_rng((1, 1)).random())
-    texts = (gamma_homotopy_text(system, lp, gamma), render_system(system))
-    sample = next(lp.chunks(paths))  # the start points are made lazily, chunk by chunk
+    lp, texts = own_start(system, groups, 1)
+    sample = next(lp.chunks(paths))[:, lp.declared]  # made lazily, chunk by chunk
     jobs = [{"texts": texts, "points": c} for c in np.array_split(sample, 4 * workers)]
     with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                       dashboard_address=":0") as cluster:  # fmt: skip

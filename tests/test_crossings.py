@@ -16,7 +16,7 @@ import subprocess
 import sys
 
 import numpy as np
-from conftest import ROOT, run_cli
+from conftest import ROOT, run_cli, same_sets
 
 from cotm_bertini.backends import crossings
 
@@ -134,3 +134,81 @@ def test_unresolved_crossings_make_the_framework_run_incomplete(tmp_path):
     assert rec["counts"]["crossings_unresolved"] == sum(v["lost"] for v in tracked) > 0
     assert any("crossed another path" in w for w in rec["warnings"])
     assert "crossed another path" in r.stderr and "path crossing(s)" not in r.stderr
+
+
+def test_the_total_degree_routes_tracker_reads_the_flags_too(capfd):
+    """The same system and sloppy tracking on the total-degree route's own start, tracked on
+    its projective patch by homotopy.tracked_paths (HomotopySolver, not ZeroDimSolver): the
+    paths Bertini flags read as CROSSING, each ends on the point of another flagged path, and
+    its raw line stays off stderr."""
+    from cotm_bertini.backends import homotopy
+    from cotm_bertini.model.polynomial import ParametricSystem
+
+    terms = (((1, (8, 0)), (-3, (1, 1)), (1, (0, 0)), (-1, (0, 3))),
+             ((1, (0, 7)), (1, (2, 1)), (-2, (0, 0)), (1, (1, 0))))  # SYSTEM's  # fmt: skip
+    ps = ParametricSystem(
+        ("x", "y"), ("f1", "f2"), (),
+        tuple(np.array([e for _, e in f], dtype=np.int64) for f in terms),
+        tuple(np.zeros((len(f), 0), dtype=np.int64) for f in terms),
+        tuple(np.array([c for c, _ in f], dtype=float) for f in terms), (),
+    )  # fmt: skip
+    lp, texts = homotopy.own_start(ps.instantiate([]), None, 1)
+    starts = np.array(list(lp.points()))[:, lp.declared]
+    sloppy = {"projective": True, "predictor": "Euler", "tracking_tolerance": 1e-1,
+              "newton_before_endgame": 1e-1, "midpath_decrease_tolerance_factor": 1}  # fmt: skip
+    out = homotopy.tracked_paths(texts, starts, "double", sloppy)
+    bad = [i for i, c in enumerate(out["codes"]) if c == crossings.CROSSING]
+    assert len(starts) == 56 and len(bad) >= 2
+    pts = out["points"][bad]
+    assert all(sorted(np.abs(pts - p).max(axis=1))[1] < 1e-8 for p in pts)  # in pairs
+    assert "path crossing(s)" not in capfd.readouterr().err
+
+
+def test_the_total_degree_route_tracks_flagged_paths_again_then_tighter(monkeypatch, capfd):
+    """The generic solve on our own start and projective patch (homotopy._own_solve): a path
+    Bertini flags is a failed path, tracked again in adaptive precision (double_then_adaptive);
+    one flagged still is tracked again at CROSSING_TOLERANCES, said and recorded; one flagged
+    even there leaves the set incomplete (generic.failed), its root missing. Bertini's flags
+    are stood in for on the first `flags(...)` finite roots of each of its calls (two in double
+    precision only; two until a call asks for the tighter tolerances; always, in that call all
+    the paths tracked again). The roots are those of the hand-written system of
+    tests/test_total_degree_route, found there by elimination."""
+    from test_total_degree_route import _roots, _system
+
+    from cotm_bertini.backends import generic, homotopy
+
+    real = homotopy.tracked_paths
+
+    def flagging(flags):
+        def tracked(texts, points, mptype, options):
+            out = real(texts, points, mptype, options)
+            ok = [k for k, c in enumerate(out["codes"]) if c == "Success" and out["finite"][k]]
+            for k in ok[: flags(mptype, "tracking_tolerance" in options)]:
+                out["codes"][k] = crossings.CROSSING
+            return out
+
+        return tracked
+
+    def solve(flags):
+        monkeypatch.setattr(homotopy, "tracked_paths", flagging(flags))
+        gs = homotopy.generic_set(_system(), 3, use_cache=False, centre={"p": 0.4})
+        return gs, _roots(gs.start["p"]), capfd.readouterr().err
+
+    gs, reference, err = solve(lambda mptype, tight: 2 * (mptype == "double"))
+    assert same_sets(gs.points, reference) and "crossings_first_solve" not in gs.route
+    assert "crossed another path" not in err
+
+    gs, reference, err = solve(lambda mptype, tight: 0 if tight else 2)
+    assert same_sets(gs.points, reference) and len(reference) == 6
+    assert gs.route["crossings_first_solve"] >= 2 and gs.route["crossings_unresolved"] == 0
+    assert gs.route["crossings_solved_again_at"] == homotopy.CROSSING_TOLERANCES
+    assert not generic.failed(gs)
+    assert "crossed another path and Bertini could not part them" in err
+    assert "again: no crossing left" in err and "path crossing(s)" not in err
+
+    gs, reference, err = solve(lambda mptype, tight: 12 if tight else 2)  # 12: all its paths
+    left = gs.route["crossings_unresolved"]
+    assert left == gs.route["crossings_first_solve"] >= 2 and generic.failed(gs)
+    assert len(gs.points) == len(reference) - left
+    assert all(np.abs(reference - p).max(axis=1).min() < 1e-8 for p in gs.points)  # all right
+    assert "is incomplete" in err and f"{left} paths crossed another path, unresolved" in err

@@ -149,11 +149,13 @@ def test_params_takes_the_seed_and_route_of_the_first_solve(tmp_path):
     zeeman = str(ROOT / "examples" / "zeeman.toml")
     real = run_cli("params", "--framework", zeeman, "--seed", "3", env=env)
     assert real.returncode == 0 and "zeeman: the real route" in real.stdout, real.stderr
-    mono = run_cli("params", "--framework", zeeman, "--seed", "3", "--route", "complex", env=env)
+    mono = run_cli("params", "--framework", zeeman, "--seed", "3", "--generic", "monodromy",
+                   env=env)  # fmt: skip
     assert mono.returncode == 0, mono.stderr
     assert "first solve of zeeman (seed 3)" in mono.stdout and "by monodromy" in mono.stdout
-    total = run_cli("params", "--framework", zeeman, "--generic", "total-degree", env=env)
+    total = run_cli("params", "--framework", zeeman, "--route", "complex", env=env)  # few paths
     assert "x 2 seeds" in total.stdout and "by monodromy" not in total.stdout
+    assert "by total-degree (2 seeds x" in total.stdout
     refused = run_cli("params", "case3", "--seed", "3", env=env)
     assert refused.returncode == 2 and refused.stdout == ""
     assert "--seed: only with --framework" in refused.stderr

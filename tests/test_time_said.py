@@ -1,4 +1,4 @@
-"""Time said, and no silent minutes (issue 39, item 6): the cost statement on the default route,
+"""Time said, and no silent minutes (issue 39, item 6): the cost statement by monodromy,
 a finished sweep run again (to draw its page) that solves nothing, and the events' refinement
 reporting its progress on stderr (a plan reusing the identical map: tests/test_motion.py, which
 has that map made already).
@@ -12,34 +12,41 @@ from __future__ import annotations
 import re
 
 import pytest
-from conftest import ROOT, run_cli
+from conftest import ROOT
 from test_progress import zeeman_paths
 
+import cotm_bertini as cb
 from cotm_bertini import progress
 
 ZEEMAN = ROOT / "examples" / "zeeman.toml"
 
 
-def test_params_framework_on_the_default_route_says_why_no_time_and_times_the_fallback(
-    tmp_path,
+def test_params_framework_by_monodromy_says_why_no_time_and_times_the_fallback(
+    tmp_path, monkeypatch
 ):
-    """`params --framework` by monodromy (the default), empty cache: it says plainly that the
-    search has no time estimate and why, and gives the total-degree fallback's paths (two
-    seeds x the Bezout number) and its time at the rate it measured (paths x rate)."""
-    res = run_cli("params", "--framework", str(ZEEMAN), "--route", "complex",
-                  env={"COTM_CACHE": str(tmp_path)})  # fmt: skip
-    assert res.returncode == 0, res.stderr
-    assert "no time estimate: a monodromy search tracks paths until its trace test passes" in (
-        res.stdout
-    )
+    """`params --framework`'s statement (cb.cost's lines) for a taut set found by monodromy by
+    default (zeeman's, under a route rule lowered to 0 paths: at its 24 paths it would take
+    total degree), empty cache: it says plainly that the search has no time estimate and why,
+    and gives the total-degree fallback's paths (two seeds x the Bezout number) and its time at
+    the rate it measured (paths x rate). With monodromy asked for there is no fallback to time."""
+    from cotm_bertini.backends import generic
+
+    monkeypatch.setenv("COTM_CACHE", str(tmp_path))
+    monkeypatch.setattr(generic, "TOTAL_DEGREE_PATHS", 0)
+    fw = cb.Framework.from_toml(ZEEMAN)
+    text = "\n".join(cb.cost(fw, cb.Settings(route="complex")).lines())
+    assert "no time estimate: a monodromy search tracks paths until its trace test passes" in text
     m = re.search(
         r"the total-degree fallback tracks (\d+) paths \(two seeds\), an estimated ([\d.]+) s "
         r"at ([\d.]+) s a path \(measured on the first (\d+) paths",
-        res.stdout,
+        text,
     )
-    assert m, res.stdout
+    assert m, text
     assert int(m[1]) == 2 * zeeman_paths()
     assert float(m[2]) == pytest.approx(int(m[1]) * float(m[3]), rel=0.06, abs=0.06)
+    asked = cb.cost(fw, cb.Settings(generic="monodromy")).headline()
+    assert "fallback" not in asked
+    assert f"the total-degree route would track {zeeman_paths()} paths per set" in asked
 
 
 def test_a_finished_sweep_run_again_with_html_solves_nothing(tmp_path, monkeypatch, capfd):

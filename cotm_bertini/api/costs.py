@@ -2,14 +2,16 @@
 the first line of a solve).
 
 A framework is solved taut set by taut set; each taut set that does not move freely needs a
-generic solution set. By monodromy (`generic='monodromy'`, backends/generic.py) its paths follow
+generic solution set, by the route backends.generic.route_choice gives it (each set's line says
+which and why: total degree for a set of few paths, else monodromy; `generic` overrides it).
+By monodromy its paths follow
 the number of solutions, which no count knows before the solve: the statement gives the Bezout
 number as what the total-degree route would track, and no time estimate (the progress lines
 measure the rate as the paths finish). By the total-degree route it needs two (seeds s and
 s + SECOND_START, the second a cross-check of the first), each an ab-initio solve of as many
 paths as the multihomogeneous Bezout number of its variable groups. A generic set already in
 the cache costs nothing. The time a path takes is measured on the first paths of the largest
-taut set's generic solve itself (the same ZeroDimSolver call, stopped after SAMPLE_SECONDS):
+taut set's generic solve itself (its first chunks of paths, until SAMPLE_SECONDS have passed):
 an estimate, and said to be one (paths differ in cost; on the examples the whole solve took
 0.5 to 2 times the rate of its first paths).
 """
@@ -22,10 +24,11 @@ from dataclasses import dataclass
 from ..settings import Settings
 
 SAMPLE_SECONDS = 4.0  # the first paths of the solve itself, tracked this long, give the rate
+SAMPLE_CHUNK = 8  # paths a Bertini call of the sample (the clock is read between calls)
 SAMPLE_FROM = 30.0  # a solve samples the rate when its first guess is beyond this (seconds)
-# Bertini lays out every start point before its first path, about 1.1 ms a point (prism_slack's
-# smallest taut set: 46,656 paths, 56 s and no path finished in a 4 s sample; measured): a
-# set of more paths is not sampled, the largest set below this is.
+# A set of more paths is not sampled, the largest set below this is (a 4 s sample of it would
+# be a few paths of tens of thousands; Bertini's own start, used before, also laid out every
+# start point first: prism_slack's smallest set spent 56 s there, measured).
 SAMPLE_MAX_PATHS = 5_000
 HOUR = 3600.0  # an estimate beyond this is said plainly, with what to do about it
 
@@ -40,6 +43,9 @@ class SetCost:
     paths: int  # per generic set: the multihomogeneous Bezout number of its variable groups
     free: bool  # moves freely with the other cables slack: not solved (a continuum check)
     cached: tuple[int, ...]  # seeds whose generic set is in the cache already
+    route: str = "total-degree"  # of its generic sets (backends.generic.route_choice)
+    why: str = ""  # why that route
+    seeds: tuple[int, ...] = ()  # the seeds of its generic sets (two by total degree)
 
     @property
     def label(self) -> str:
@@ -64,23 +70,30 @@ class Cost:
 
     @property
     def paths(self) -> int:
-        """Paths of every generic set the solve needs, cached or not."""
-        return sum(s.paths * len(self.seeds) for s in self.sets if not s.free)
+        """Paths of every generic set the solve needs, cached or not (a monodromy set counted
+        as the total-degree route's paths of one seed: its own are not known before)."""
+        return sum(s.paths * len(s.seeds) for s in self.sets if not s.free)
 
     @property
     def paths_to_solve(self) -> int:
         """Paths of the generic sets not in the cache: the work still to do."""
         return sum(
-            s.paths * sum(seed not in s.cached for seed in self.seeds)
-            for s in self.sets
-            if not s.free
+            s.paths * sum(seed not in s.cached for seed in s.seeds) for s in self.sets if not s.free
         )
 
     @property
+    def by_monodromy(self) -> list[SetCost]:
+        """The taut sets whose generic set is still to be found by monodromy."""
+        return [
+            s for s in self.sets
+            if not s.free and s.route == "monodromy" and len(s.cached) < len(s.seeds)
+        ]  # fmt: skip
+
+    @property
     def estimate(self) -> float:
-        """Seconds the generic sets still to solve take at the rate (an estimate; NaN by
-        monodromy, whose path count is not known before the solve)."""
-        if self.route == "monodromy" and self.paths_to_solve:
+        """Seconds the generic sets still to solve take at the rate (an estimate; NaN when a
+        set is to be found by monodromy, whose path count is not known before the solve)."""
+        if self.by_monodromy:
             return float("nan")
         return self.paths_to_solve * self.seconds_per_path
 
@@ -98,20 +111,18 @@ class Cost:
                 "--route complex solves every complex root of every taut set instead)"
             )
         solved = [s for s in self.sets if not s.free]
-        counts = sorted({s.paths for s in solved})
-        per = "+".join(str(s.paths) for s in solved) if len(solved) <= 4 else (
-            f"{counts[0]} to {counts[-1]}")  # fmt: skip
-        per = per or "0"
+        tracked = [s for s in solved if s.route != "monodromy"]  # paths counted beforehand
         free = len(self.sets) - len(solved)
-        text = (
-            f"{self._taut_sets()}"
-            + (f" ({free} moving freely, not solved)" if free else "")
-            + f", {per} paths per generic set x {len(self.seeds)} seeds = {self.paths} paths"
-        )
+        text = self._taut_sets() + (f" ({free} moving freely, not solved)" if free else "")
+        if tracked or not solved:
+            seeds = max(len(s.seeds) for s in tracked) if tracked else len(self.seeds)
+            text += (f", {_per_set(tracked)} paths per generic set x {seeds} seeds = "
+                     f"{sum(s.paths * len(s.seeds) for s in tracked)} paths")  # fmt: skip
         if not self.paths_to_solve:
             return f"{text}; every generic set is in the cache already"
-        if self.route == "monodromy":
-            return self._monodromy(solved, per)
+        mono = self.by_monodromy
+        if mono:
+            return self._monodromy(text, mono, bool(tracked))
         from ..progress import duration
 
         also = "; and a monodromy set of the same seed to check it" * (self.route == "both")
@@ -121,21 +132,22 @@ class Cost:
             f"({self.rate_source}){also}"
         )
 
-    def _monodromy(self, solved: list[SetCost], per: str) -> str:
-        """The headline by monodromy: no time (and why), and what the total-degree fallback
-        would take at a rate measured now, when one was."""
+    def _monodromy(self, text: str, mono: list[SetCost], tracked: bool) -> str:
+        """The headline with generic sets `mono` to find by monodromy (after `text`, which
+        counts the `tracked` sets' paths): no time (and why), and what the total-degree
+        fallback would take at a rate measured now, when one was."""
         from ..progress import duration
 
-        todo = sum(len(self.seeds) - len(s.cached) for s in solved)
-        text = (
-            f"{self._taut_sets()}, {todo} generic set{'s' * (todo != 1)} to find by monodromy; "
-            "no time estimate: a monodromy search tracks paths until its trace test passes, "
-            "and how many it needs follows the number of solutions, which nothing counts "
-            "before the solve (the progress lines measure the rate as it runs)"
+        sets = f"{len(mono)} generic set{'s' * (len(mono) != 1)}"
+        text += (
+            f"{' and ' if tracked else ', '}{sets} to find by monodromy; no time estimate: a "
+            "monodromy search tracks paths until its trace test passes, and how many it needs "
+            "follows the number of solutions, which nothing counts before the solve (the "
+            "progress lines measure the rate as it runs)"
         )
-        fallback = 2 * sum(s.paths for s in solved if len(s.cached) < len(self.seeds))
         if not self.measured:
-            return f"{text}; the total-degree route would track {per} paths per set"
+            return f"{text}; the total-degree route would track {_per_set(mono)} paths per set"
+        fallback = 2 * sum(s.paths for s in mono)
         return (
             f"{text}; should a trace test fail, the total-degree fallback tracks {fallback} "
             f"paths (two seeds), an estimated {duration(fallback * self.seconds_per_path)} at "
@@ -175,7 +187,9 @@ class Cost:
             cached = ", ".join(str(k) for k in s.cached)
             out.append(
                 f"#   taut set {s.label}: {s.unknowns} unknowns in {s.groups} groups, "
-                f"{s.paths} paths per generic set" + (f" (seeds {cached} cached)" if cached else "")
+                f"{s.paths} paths per generic set"
+                + (f" (seeds {cached} cached)" if cached else "")
+                + f"; by {s.route} ({s.why})"
             )
         out.append(f"# {self.headline()}")
         if self.measured:
@@ -185,30 +199,32 @@ class Cost:
         return out
 
 
-def sample_rate(ps, groups, seed: int, centre: dict) -> tuple[float, int]:
-    """(wall seconds a path, paths finished): the generic solve of `ps` for `seed` itself (the
-    same ZeroDimSolver call, on every core) run for SAMPLE_SECONDS, its paths counted as they
-    finish; with none finished, the seconds spent (a lower bound)."""
-    from bertini import nag_algorithm as na
+def _per_set(sets: list[SetCost]) -> str:
+    """The path counts a set of these taut sets, "a+b+c" (or "a to b" for many)."""
+    counts = sorted({s.paths for s in sets})
+    if not counts:
+        return "0"
+    if len(sets) <= 4:
+        return "+".join(str(s.paths) for s in sets)
+    return f"{counts[0]} to {counts[-1]}"
 
-    from ..backends.crossings import solve as quiet_solve
-    from ..backends.homotopy import GENERIC_MAX_STEPS, _bertini, generic_start, solver_errors
-    from ..backends.path_progress import watched
-    from ..backends.render import render_system
-    from ..progress import Progress
+
+def sample_rate(ps, groups, seed: int, centre: dict) -> tuple[float, int]:
+    """(wall seconds a path, paths finished): the generic solve of `ps` for `seed` itself (its
+    start and homotopy, homotopy.track_chunk on every core) on its first chunks of SAMPLE_CHUNK
+    paths until SAMPLE_SECONDS have passed."""
+    from ..backends.homotopy import generic_start, own_start, solver_errors, track_chunk
 
     start = generic_start(ps, seed, centre)
     system = ps.instantiate([start[n] for n in ps.parameters])
-    report = Progress("sample", None, "paths", force=True, delay=1e9)  # counts, never shown
-    t0 = time.perf_counter()
+    t0, done = time.perf_counter(), 0
     with solver_errors(f"a sample of the generic solve (seed {seed})"):
-        bertini = _bertini()
-        bertini.random.set_random_seed(seed)
-        solver = na.ZeroDimSolver(bertini.parse.system(render_system(system, groups)))
-        solver.set(max_num_steps=GENERIC_MAX_STEPS, max_solve_wall_clock_duration=SAMPLE_SECONDS)
-        with watched(solver, report):
-            quiet_solve(solver)
-    done = int(report.done)
+        lp, texts = own_start(system, groups, seed)
+        for chunk in lp.chunks(SAMPLE_CHUNK):
+            track_chunk({"texts": texts, "points": chunk[:, lp.declared], "threads": None})
+            done += len(chunk)
+            if time.perf_counter() - t0 > SAMPLE_SECONDS:
+                break
     return (time.perf_counter() - t0) / max(done, 1), done
 
 
@@ -219,37 +235,37 @@ def cost(fw, settings: Settings | None = None, *, sample: bool | None = True) ->
     taut set (kept in the cache for the solve). `sample`: False, a first guess only (from an
     earlier solve in this process, or a fixed prior); None, sample only when the first guess
     is beyond SAMPLE_FROM seconds."""
-    from ..backends.generic import route_of
-    from ..backends.homotopy import SECOND_START
     from ..backends.path_progress import first_guess, remember
     from ..point import framework_route
 
     settings = settings or Settings()
     if framework_route(fw, settings) == "real":
         return Cost(fw.name, (), (settings.seed,), 0.0, "no generic set", False, 0.0, "real")
-    route = route_of(settings)
-    # "both": the total-degree set of the seed itself is the one counted (and a monodromy set).
-    one = route in ("monodromy", "both")
-    seeds = (settings.seed,) if one else (settings.seed, settings.seed + SECOND_START)
     t0 = time.perf_counter()
-    sets, systems, pruned = _sets(fw, seeds, route)
+    sets, systems, pruned = _sets(fw, settings)
     derive_seconds = time.perf_counter() - t0
-    todo = [k for k, s in enumerate(sets) if not s.free and len(s.cached) < len(seeds)]
+    # Sets whose paths are counted beforehand (total degree, "both"'s set of the seed) and
+    # still to solve: the rate is theirs; a monodromy set's paths are not known before. A set
+    # by monodromy by default counts only when asked (`params`): the rate then times the
+    # total-degree fallback a failed trace test takes (an explicit 'monodromy' has none).
+    fallback = sample is True and settings.generic is None
+    todo = [
+        k for k, s in enumerate(sets)
+        if not s.free and (s.route != "monodromy" or fallback) and len(s.cached) < len(s.seeds)
+    ]  # fmt: skip
     big = max(todo, key=lambda k: sets[k].paths) if todo else None
     rate, source = first_guess(*systems[big][:2]) if big is not None else (0.0, "nothing to do")
     source, measured = f"a first guess: {source}", False
-    pending = sum(sets[k].paths * (len(seeds) - len(sets[k].cached)) for k in todo)
+    pending = sum(sets[k].paths * (len(sets[k].seeds) - len(sets[k].cached)) for k in todo)
     wanted = sample or (sample is None and pending * rate > SAMPLE_FROM)
     small = [k for k in todo if sets[k].paths <= SAMPLE_MAX_PATHS]
     probe = max(small, key=lambda k: sets[k].paths) if small else None
-    # By monodromy only when asked (`params`): the rate then times the total-degree fallback.
-    wanted = wanted and (route != "monodromy" or sample is True)
     if big is not None and wanted and probe is None:
-        source += (f" (not sampled: every taut set has more than {SAMPLE_MAX_PATHS:,} paths, "
-                   "and Bertini lays out every start point before its first path)")  # fmt: skip
+        source += (f" (not sampled: every taut set has more than {SAMPLE_MAX_PATHS:,} "
+                   "paths)")  # fmt: skip
     elif big is not None and wanted:
         ps, groups, centre = systems[probe]
-        rate, n = sample_rate(ps, groups, seeds[0], centre)
+        rate, n = sample_rate(ps, groups, settings.seed, centre)
         source = (
             f"measured on the first {n} paths of taut set {sets[probe].label}"
             if n
@@ -257,13 +273,19 @@ def cost(fw, settings: Settings | None = None, *, sample: bool | None = True) ->
         )
         remember(ps, groups, rate, source)
         measured = True
+    routes = {s.route for s in sets if not s.free} or {"total-degree"}
+    route = routes.pop() if len(routes) == 1 else "mixed"
+    seeds = max((s.seeds for s in sets), key=len, default=(settings.seed,))
     return Cost(fw.name, tuple(sets), seeds, rate, source, measured, derive_seconds, route, pruned)
 
 
-def _sets(fw, seeds: tuple[int, ...], route: str) -> tuple[list[SetCost], list[tuple], int]:
-    """Each taut set's SetCost and (system, groups, centre) of its generic solves, derived in
-    order with "taut set k/n" in the derivation's progress lines; and how many were pruned."""
-    from ..backends.homotopy import generic_path
+def _sets(fw, settings: Settings) -> tuple[list[SetCost], list[tuple], int]:
+    """Each taut set's SetCost (its route by backends.generic.route_choice, on its path count)
+    and (system, groups, centre) of its generic solves, derived in order with "taut set k/n" in
+    the derivation's progress lines; and how many were pruned."""
+    from ..backends.generic import route_choice
+    from ..backends.homotopy import SECOND_START, generic_key, generic_path
+    from ..backends.monodromy import ROUTE
     from ..backends.path_progress import path_count
     from ..model.framework.compiled import framework_system, variable_groups
     from ..model.framework.units import normalized_slots
@@ -276,25 +298,21 @@ def _sets(fw, seeds: tuple[int, ...], route: str) -> tuple[list[SetCost], list[t
         fs = framework_system(fw, taut, label=f"taut set {k + 1}/{len(tauts)}")
         groups = variable_groups(fs)
         centre = {n: slots[n] for n in fs.ps.parameters}
-        cached = tuple(
-            seed for seed in seeds
-            if generic_path(_key(fs.ps, seed, centre, groups, route)).is_file()
-        )  # fmt: skip
         free = bool(fs.free)
         paths = 0 if free else path_count(fs.ps, groups)
-        sets.append(SetCost(taut, len(fs.ps.variables), len(groups), paths, free, cached))
+        route, why = route_choice(settings, paths)
+        # "both": the total-degree set of the seed itself is the one counted (and a monodromy
+        # set); by monodromy one set (its trace test the evidence); by total degree two.
+        one = route in ("monodromy", "both")
+        seeds = (settings.seed,) if one else (settings.seed, settings.seed + SECOND_START)
+        key = {"route": ROUTE} if route == "monodromy" else {"groups": groups}
+        keys = {seed: generic_key(fs.ps, seed, centre, **key) for seed in seeds}
+        cached = tuple(seed for seed in seeds if generic_path(keys[seed]).is_file())
+        sets.append(
+            SetCost(taut, len(fs.ps.variables), len(groups), paths, free, cached, route, why, seeds)
+        )
         systems.append((fs.ps, groups, centre))
     return sets, systems, len(pruned)
-
-
-def _key(ps, seed: int, centre: dict, groups, route: str) -> str:
-    """The cache key of a generic set by this route (the monodromy one ignores groups)."""
-    from ..backends.homotopy import generic_key
-    from ..backends.monodromy import ROUTE
-
-    if route == "monodromy":
-        return generic_key(ps, seed, centre, route=ROUTE)
-    return generic_key(ps, seed, centre, groups)
 
 
 def announce(fw, settings: Settings) -> Cost | None:

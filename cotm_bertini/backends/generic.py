@@ -10,10 +10,11 @@ random complex start parameters, homotopy.generic_start):
   a second set from an independent start (seed + SECOND_START) with the same count.
 
 `Settings.generic` chooses: "monodromy", "total-degree", or "both" (the monodromy set, checked
-against the total-degree set of the same seed); unset, DEFAULT_ROUTE, monodromy (one set and
-its proof instead of two sets, and a cost that follows the solutions: docs/benchmarks.md), or
-total-degree with a Dask scheduler (which splits that route's paths over its workers).
-Both routes' sets are cached apart (the key names the route), so each is solved once.
+against the total-degree set of the same seed). Unset (`route_choice`): total-degree with a
+Dask scheduler (which splits that route's paths over its workers); for a framework's taut set
+(its variable groups known), total-degree when its two seeds track at most TOTAL_DEGREE_PATHS
+paths, else monodromy; for a system without groups (the paper's mechanism), DEFAULT_ROUTE,
+monodromy. Both routes' sets are cached apart (the key names the route), so each is solved once.
 """
 
 from __future__ import annotations
@@ -76,14 +77,54 @@ def monodromy_set(
 
 
 DEFAULT_ROUTE = "monodromy"
+# The total-degree route solves a taut set by default when its two seeds track at most this
+# many paths (2 x its multihomogeneous Bezout number). Below it the route tracks fewer paths
+# than monodromy is expected to: monodromy tracked 5-11 paths per root of its augmented
+# fibre N'', and N'' was 0.44-1.6 times the Bezout number on the 9 systems measured
+# (docs/benchmarks.md: at least 2.2 Bezout numbers against the route's 2), and on a projective
+# patch a path costs 0.015-0.04 CPU s (the X-module's taut sets, measured), so 5,000 paths are
+# 1-3 CPU minutes. Above it the count of roots may be far below the Bezout number (chain3: a
+# set of 1,504 roots and 86,528 Bezout paths), where monodromy's cost follows the roots.
+TOTAL_DEGREE_PATHS = 5_000
+_PATHS: dict[tuple, int] = {}  # (id(ps), groups): the Bezout number, counted once a process
 
 
-def route_of(settings: Settings) -> str:
-    """The route of `settings`: its `generic`, else DEFAULT_ROUTE (total-degree with a Dask
-    scheduler, which splits that route's paths; monodromy runs in one process)."""
+def route_choice(settings: Settings, paths: int | None = None) -> tuple[str, str]:
+    """(route, why) of a generic set: `settings.generic` if given; total-degree with a Dask
+    scheduler (monodromy runs in one process); for a set of `paths` start paths a seed (a
+    framework's taut set), total-degree when 2 x paths <= TOTAL_DEGREE_PATHS, else monodromy;
+    without a count (the paper's mechanism), DEFAULT_ROUTE."""
     if settings.generic is not None:
-        return settings.generic
-    return "total-degree" if settings.scheduler else DEFAULT_ROUTE
+        return settings.generic, f"generic = {settings.generic!r} asked for"
+    if settings.scheduler:
+        return "total-degree", "a Dask scheduler splits the total-degree route's paths"
+    if paths is None:
+        return DEFAULT_ROUTE, "the default for a system without variable groups"
+    if 2 * paths <= TOTAL_DEGREE_PATHS:
+        return "total-degree", (
+            f"2 seeds x {paths:,} paths <= {TOTAL_DEGREE_PATHS:,}: fewer than monodromy is "
+            "expected to track"
+        )
+    return "monodromy", (
+        f"2 seeds x {paths:,} paths > {TOTAL_DEGREE_PATHS:,}: monodromy's paths follow the "
+        "roots, which may be far fewer"
+    )
+
+
+def route_of(settings: Settings, ps: ParametricSystem | None = None, groups=None) -> str:
+    """The route of a generic set of `ps` (with its variable `groups`, a framework's taut set;
+    without them: the paper's mechanism) under `settings` (route_choice)."""
+    return route_choice(settings, None if ps is None or groups is None else paths_of(ps, groups))[0]
+
+
+def paths_of(ps: ParametricSystem, groups) -> int:
+    """The paths a seed of `ps`'s total-degree route tracks (path_progress.path_count), kept."""
+    from .path_progress import path_count
+
+    key = (id(ps), tuple(map(tuple, groups or ())))
+    if key not in _PATHS:
+        _PATHS[key] = path_count(ps, groups)
+    return _PATHS[key]
 
 
 def generic_for(
@@ -94,7 +135,7 @@ def generic_for(
     groups: list[list[str]] | None = None,
 ) -> GenericSet:
     """`seed`'s generic set of `ps` by the route of `settings` ("both": the monodromy one)."""
-    if route_of(settings) == "total-degree":
+    if route_of(settings, ps, groups) == "total-degree":
         return generic_set(ps, seed, centre=centre, groups=groups, scheduler=settings.scheduler)
     return monodromy_set(ps, seed, centre)
 
@@ -109,7 +150,7 @@ def evidence_sets(
     one it tracks: monodromy, its own (the trace test is its evidence); total-degree, two from
     independent starts (the same count is the evidence); both, the monodromy set and the
     total-degree set of the same seed (the same count, two routes)."""
-    route, seed = route_of(settings), settings.seed
+    route, seed = route_of(settings, ps, groups), settings.seed
     first = generic_for(ps, seed, settings, centre, groups)
     if route == "monodromy" and failed(first) and settings.generic is None:
         return _fallback(ps, settings, centre, groups, first)

@@ -16,8 +16,9 @@ import hashlib
 import json
 import time
 from collections.abc import Iterator, Mapping
-from contextlib import contextmanager, nullcontext
+from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -34,7 +35,7 @@ from . import crossings
 from .crossings import CROSSING
 from .crossings import solve as quiet_solve
 from .endpoints import Endpoints
-from .path_progress import PRIOR_SOURCE, expected, generic_report, remember, watched
+from .path_progress import PRIOR_SOURCE, expected, generic_report, remember
 from .render import render_parameter_homotopy, render_system
 from .start_system import (
     gamma_homotopy_text,
@@ -46,13 +47,21 @@ DOUBLE_FINAL_TOLERANCE = 1e-8
 DOUBLE_MAX_STEPS = 2000
 GENERIC_MAX_STEPS = 20000  # steps a path of a framework's generic solve may take
 SECOND_START = 7919  # seed offset of the independent second generic set
-# A generic solve with crossings Bertini left unresolved is solved again with these (its
-# defaults: 1e-5, 1e-5, 1e-6), 100 times tighter, as its own warning advises.
+# The paths of a generic solve left with crossings Bertini did not resolve are tracked again
+# with these (its defaults: 1e-5, 1e-5, 1e-6), 100 times tighter, as its own warning advises.
 CROSSING_TOLERANCES = {
     "tracking_tolerance": 1e-7,
     "newton_before_endgame": 1e-7,
     "newton_during_endgame": 1e-8,
 }
+ENDGAME_T = (
+    0.1  # Bertini's endgame boundary: on a patch, a path at infinity before this is retracked
+)
+PATCH_SEED = 2028  # Bertini's random patch of every projective homotopy (the same on every run)
+# A generic solve in this process goes in about LOCAL_CHUNKS Bertini calls of at least
+# LOCAL_CHUNK paths, the progress lines between them (the X-module's 128-path set: 4.9 CPU s
+# in chunks of 8, 4.6 s in chunks of 64, measured).
+LOCAL_CHUNKS, LOCAL_CHUNK = 32, 8
 ANNOUNCE_SECONDS = 2.0  # a generic solve expected to take longer is announced on stderr
 CHUNKS_PER_WORKER = 4  # a split generic solve sends this many chunks of paths per Dask worker
 BERTINI_MAX_NORM = 1e5  # Bertini's default security max norm (a larger norm counts as infinite)
@@ -217,7 +226,7 @@ def generic_set(
     complex perturbation of size START_SPREAD in every parameter. With variable `groups` the
     ab-initio solve starts from a multihomogeneous start system (fewer paths). With a Dask
     `scheduler` (an address) a solve is split: our own start system's paths in chunks on its
-    workers (`_split_solve`); the set is the same, and so is its key and cache entry."""
+    workers (`_own_solve`); the set is the same, and so is its key and cache entry."""
     if use_cache and (id(ps), seed) in _LOADED:  # ps objects live as long as the process
         return replace(_LOADED[id(ps), seed], source="memory")
     centre = START_CENTRE if centre is None else centre
@@ -304,10 +313,7 @@ def _solve_generic(
     paths, rate, _ = expected(ps, groups)
     t0 = time.perf_counter()
     with generic_report(seed, paths, paths * rate >= ANNOUNCE_SECONDS) as report:
-        if scheduler is None:
-            ends, route = _bertini_solve(system, seed, groups, report)
-        else:
-            ends, route = _split_solve(system, seed, groups, scheduler, report)
+        ends, route = _own_solve(system, seed, groups, scheduler, report)
     seconds = time.perf_counter() - t0
     codes, finite_flags, singular, pts = ends
     # The next solve of this system (the second seed) starts from this measured rate.
@@ -328,50 +334,107 @@ def _solve_generic(
     )
 
 
-def _bertini_solve(system, seed: int, groups, report=None) -> tuple[tuple, dict]:
-    """Every path of Bertini's own start system (multihomogeneous with `groups`, else total
-    degree) in one ZeroDimSolver call: (codes, finite, singular, points), the route record.
-    `report` (a progress.Progress) advances as each path finishes."""
-    cpu = time.process_time()
-    meta, pts = _zero_dim(system, seed, groups, report)
-    meta, pts, again = _part_crossings(system, seed, groups, meta, pts)
-    points = _end_points(pts, len(system.variables))
-    if groups:
-        # Bertini orders the variables group by group; a merged group breaks our order.
-        declared = [v for g in groups for v in g]
-        points = points[:, [declared.index(v) for v in system.variables]]
-    ends = (
-        [_code(m) for m in meta],
-        [bool(m.is_finite) for m in meta],
-        [is_singular(m) for m in meta],
-        points,
-    )
-    start = "multihomogeneous" if groups else "total-degree"
+def own_start(system, groups, seed: int) -> tuple:
+    """(start, (homotopy text, target text)): `seed`'s random linear-product start system of
+    `system` for `groups` (None: total degree) and the gamma-trick homotopy to `system`, both
+    texts declaring the start's variable groups (points in `start.declared` order)."""
+    lp = linear_product_start(system, groups, seed)
+    gamma = np.exp(2j * np.pi * np.random.default_rng((seed, 1)).random())
+    names = [[system.variables[k] for k in g] for g in lp.groups]
+    return lp, (gamma_homotopy_text(system, lp, gamma), render_system(system, names))
+
+
+def _own_solve(system, seed: int, groups, scheduler=None, report=None) -> tuple[tuple, dict]:
+    """Every path of our own linear-product start system (backends.start_system) on a
+    multiprojective patch, in chunks (`track_chunk`): in this process, or on the Dask workers at
+    `scheduler`: (codes, finite, singular, points), the route record. `report` (a
+    progress.Progress) advances as each chunk comes back."""
+    from .dask_jobs import run_jobs
+
+    lp, texts = own_start(system, groups, seed)
+    total, starts, workers = lp.count(), [], []
+
+    def job(points: np.ndarray, **more) -> dict:
+        return {"texts": texts, "points": points[:, lp.declared], **more}
+
+    def jobs(n: int) -> list[dict]:
+        workers.append(n)
+        starts.extend(lp.chunks(max(1, -(-total // (CHUNKS_PER_WORKER * n)))))
+        return [job(c) for c in starts]
+
+    def run(batch) -> Iterator[tuple[int, dict]]:
+        if scheduler is not None:
+            return run_jobs(track_chunk, batch, scheduler)
+        return ((k, track_chunk({**j, "threads": None})) for k, j in enumerate(batch))
+
+    batch = jobs
+    if scheduler is None:  # chunks for the progress lines; Bertini's threads share each one
+        workers.append(1)
+        starts.extend(lp.chunks(max(LOCAL_CHUNK, -(-total // LOCAL_CHUNKS))))
+        batch = [job(c) for c in starts]
+    done = {}
+    for k, chunk in run(batch):
+        done[k] = chunk
+        if report is not None:
+            report.update(len(chunk["codes"]))
+    chunks = [done[k] for k in range(len(done))]
+    ends = [[x for c in chunks for x in c[f]] for f in ("codes", "finite", "singular")]
+    back = np.argsort(lp.declared)  # Bertini's coordinates are group by group
+    pts = np.vstack([c["points"] for c in chunks])[:, back]
+
+    def again(idx: list[int], **more) -> float:
+        """The paths `idx` tracked again in adaptive precision (with `more`), their ends
+        replaced: the CPU seconds it took."""
+        out = next(iter(run([job(np.vstack(starts)[idx], mptype="adaptive", **more)])))[1]
+        for k, i in enumerate(idx):
+            for f, col in zip(("codes", "finite", "singular"), ends, strict=True):
+                col[i] = out[f][k]
+            pts[i] = out["points"][k][back]
+        return out["cpu_seconds"]
+
+    twins = _twins(*ends, pts)  # one path jumped onto another's root in double precision
+    again_cpu = again(twins) if twins else 0.0
+    crossing_cpu, crossings_record = _part_crossings(seed, ends[0], again)
+    for i in _twins(*ends, pts):  # still together: a multiple root, as ZeroDimSolver says
+        ends[2][i] = True
+    where = f"on {scheduler}" if scheduler else "in this process"
     route = {
-        "method": f"bertini {start} start (ZeroDimSolver), one call",
-        "cpu_seconds": round(time.process_time() - cpu, 3),
+        "method": f"own {'multihomogeneous' if groups else 'total-degree'} linear-product "
+        f"start on a projective patch, double then adaptive precision, {len(chunks)} chunks "
+        f"{where}",
+        "scheduler": scheduler,
+        "workers": workers[0],
+        "chunks": len(chunks),
+        "paths_per_chunk": [len(c["codes"]) for c in chunks],
+        "chunk_seconds": [round(c["seconds"], 3) for c in chunks],
+        "cpu_seconds": round(sum(c["cpu_seconds"] for c in chunks) + again_cpu + crossing_cpu, 3),
+        "retracked_adaptive": sum(c["retracked_adaptive"] for c in chunks)
+        + len(twins)
+        + crossings_record.get("crossings_first_solve", 0),
         "failed_paths": _failed(ends[0]),
-        **again,
+        **crossings_record,
     }
-    return ends, route
+    return (*ends, pts), route
 
 
-def _part_crossings(system, seed: int, groups, meta, pts) -> tuple:
-    """(metadata, points, record): the solve as it was when no path's crossing was left
-    unresolved; else solved again from the same start at CROSSING_TOLERANCES, said, and
-    recorded (a set whose crossings remain is incomplete: its route says why)."""
-    crossed = sum(_code(m) == CROSSING for m in meta)
+def _part_crossings(seed: int, codes: list[str], again) -> tuple[float, dict]:
+    """(CPU seconds, record): nothing when no path of the generic solve is still flagged as
+    crossing another (CROSSING, after its retrack in adaptive precision); else those paths
+    tracked again (`again`, which replaces their ends in `codes`) at CROSSING_TOLERANCES,
+    said, and recorded (a set whose crossings remain is incomplete: its route says why)."""
+    crossed = [i for i, c in enumerate(codes) if c == CROSSING]
     if not crossed:
-        return meta, pts, {}
+        return 0.0, {}
     # Bertini's own re-tracks (each at half the tolerance) did not part two paths.
     say(
-        f"cotm-bertini: warning: {crossed} paths of the generic solve (seed {seed}) crossed "
-        "another path and Bertini could not part them (the affected solutions may be wrong); "
-        f"solving it again from the same start at tracking tolerances {CROSSING_TOLERANCES}"
+        f"cotm-bertini: warning: {len(crossed)} paths of the generic solve (seed {seed}) "
+        "crossed another path and Bertini could not part them (the affected solutions may be "
+        f"wrong); tracking them again from their starts at tracking tolerances "
+        f"{CROSSING_TOLERANCES}"
     )
-    meta, pts = _zero_dim(system, seed, groups, None, CROSSING_TOLERANCES)
-    left = sum(_code(m) == CROSSING for m in meta)
-    record = {"crossings_first_solve": crossed, "crossings_unresolved": left,
+    cpu = again(crossed, tolerances=CROSSING_TOLERANCES)
+    left = sum(codes[i] == CROSSING for i in crossed)
+    record = {"crossings_first_solve": len(crossed), "crossings_unresolved": left,
               "crossings_solved_again_at": CROSSING_TOLERANCES}  # fmt: skip
     if left:
         why = (f"{left} paths crossed another path, unresolved even at tracking tolerances "
@@ -380,77 +443,7 @@ def _part_crossings(system, seed: int, groups, meta, pts) -> tuple:
         record.update(complete=False, reason=why)
     else:
         say(f"cotm-bertini: the generic solve (seed {seed}) again: no crossing left")
-    return meta, pts, record
-
-
-def _zero_dim(system, seed: int, groups, report=None, tolerances: dict | None = None):
-    """One ZeroDimSolver call from Bertini's own start system for `seed`: (metadata, points).
-    `report` (a progress.Progress) advances as each path finishes; `tolerances`: tracking
-    settings other than Bertini's defaults."""
-    bertini = _bertini()
-    from bertini import nag_algorithm as na
-
-    bertini.random.set_random_seed(seed)
-    solver = na.ZeroDimSolver(bertini.parse.system(render_system(system, groups)))
-    if groups:
-        # A framework's start system can send a few paths crawling for ever; a path cut short
-        # shows up as a count the second generic set (another seed) does not confirm.
-        solver.set(max_num_steps=GENERIC_MAX_STEPS)
-    if tolerances:
-        solver.set(**tolerances)
-    with watched(solver, report) if report is not None else nullcontext():
-        quiet_solve(solver)  # our report, not Bertini's own bar
-    return solver.solution_metadata(), solver.all_solutions()
-
-
-def _split_solve(system, seed: int, groups, scheduler: str, report=None) -> tuple[tuple, dict]:
-    """Every path of our own linear-product start system (backends.start_system), tracked in
-    chunks on the Dask workers at `scheduler`: (codes, finite, singular, points), the route.
-    `report` (a progress.Progress) advances as each chunk comes back."""
-    from .dask_jobs import run_jobs
-
-    lp = linear_product_start(system, groups, seed)
-    gamma = np.exp(2j * np.pi * np.random.default_rng((seed, 1)).random())
-    texts = (gamma_homotopy_text(system, lp, gamma), render_system(system))
-    total, starts, workers = lp.count(), [], []
-
-    def jobs(n: int) -> list[dict]:
-        workers.append(n)
-        starts.extend(lp.chunks(max(1, -(-total // (CHUNKS_PER_WORKER * n)))))
-        return [{"texts": texts, "points": c} for c in starts]
-
-    done = {}
-    for k, chunk in run_jobs(track_chunk, jobs, scheduler):
-        done[k] = chunk
-        if report is not None:
-            report.update(len(chunk["codes"]))
-    chunks = [done[k] for k in range(len(done))]
-    ends = [[x for c in chunks for x in c[f]] for f in ("codes", "finite", "singular")]
-    pts = np.vstack([c["points"] for c in chunks])
-    twins, again_cpu = _twins(*ends, pts), 0.0
-    if twins:  # one path jumped onto another's root in double precision: both again, in AMP
-        job = {"texts": texts, "points": np.vstack(starts)[twins], "mptype": "adaptive"}
-        again = next(iter(run_jobs(track_chunk, [job], scheduler)))[1]
-        again_cpu = again["cpu_seconds"]
-        for k, i in enumerate(twins):
-            for f, col in zip(("codes", "finite", "singular"), ends, strict=True):
-                col[i] = again[f][k]
-            pts[i] = again["points"][k]
-        for i in _twins(*ends, pts):  # still together: a multiple root, as ZeroDimSolver says
-            ends[2][i] = True
-    route = {
-        "method": f"own {'multihomogeneous' if groups else 'total-degree'} linear-product "
-        f"start, split in {len(chunks)} chunks on {scheduler}",
-        "scheduler": scheduler,
-        "workers": workers[0],
-        "chunks": len(chunks),
-        "paths_per_chunk": [len(c["codes"]) for c in chunks],
-        "chunk_seconds": [round(c["seconds"], 3) for c in chunks],
-        "cpu_seconds": round(sum(c["cpu_seconds"] for c in chunks) + again_cpu, 3),
-        "retracked_adaptive": sum(c["retracked_adaptive"] for c in chunks) + len(twins),
-        "failed_paths": _failed(ends[0]),
-    }
-    return (*ends, pts), route
+    return cpu, record
 
 
 def _failed(codes: list[str]) -> int:
@@ -487,61 +480,119 @@ def _end_points(pts, n: int) -> np.ndarray:
     return out
 
 
-def _track_texts(texts: tuple[str, str], points: np.ndarray, mptype: str) -> dict:
-    """The homotopy texts[0] (target texts[1]) tracked from `points` on one thread (the
-    parallelism is the cluster's), with the step caps of track and the generic solve."""
-    bertini = _bertini()
-    from bertini import nag_algorithm as na
-
-    hom, target = (bertini.parse.system(text) for text in texts)
-    solver = na.HomotopySolver(hom, list(points), target, mptype=mptype)
-    if mptype == "double":  # as in track: give up early, adaptive precision redoes it
-        solver.set(final_tolerance=DOUBLE_FINAL_TOLERANCE, max_num_steps=DOUBLE_MAX_STEPS)
-    else:
-        solver.set(max_num_steps=GENERIC_MAX_STEPS)
-    solver.set(num_threads=1)
-    quiet_solve(solver)
-    meta, pts = solver.solution_metadata(), solver.all_solutions()
-    return {
-        "codes": [_code(m) for m in meta],
-        "finite": [bool(m.is_finite) for m in meta],
-        "singular": [is_singular(m) for m in meta],
-        "points": _end_points(pts, points.shape[1]),
-    }
-
-
 def track_chunk(job: dict) -> dict:
-    """One chunk of a split generic solve (a Dask task: plain data in, plain data out): the
-    gamma-trick homotopy `job["texts"]` tracked from `job["points"]` in double precision, and
-    every path that does not end at a nonsingular finite point (or that meets another) again
-    in adaptive precision, as `track` does (`job["mptype"] = "adaptive"`: all in AMP)."""
-    t0, cpu = time.perf_counter(), time.process_time()  # one task at a time a worker process
+    """One chunk of a generic solve (a Dask task: plain data in, plain data out): the
+    gamma-trick homotopy `job["texts"]` tracked from `job["points"]` on a projective patch by
+    double_then_adaptive (`job["mptype"] = "adaptive"`: all in AMP); `job["threads"]`:
+    Bertini's threads (None: its default, every core; 1 on a cluster, whose workers are the
+    parallelism); `job["tolerances"]`: tracking tolerances other than Bertini's defaults."""
+    t0 = time.perf_counter()  # one task at a time a worker process
     points = np.asarray(job["points"], dtype=complex)
+    options = {
+        "projective": True,
+        "max_norm": BERTINI_MAX_NORM,
+        "num_threads": job.get("threads", 1),
+        **job.get("tolerances", {}),  # CROSSING_TOLERANCES for paths left crossing
+    }
     if job.get("mptype") == "adaptive":
-        out, redo = _track_texts(job["texts"], points, "adaptive"), []
+        cpu = time.process_time()
+        out = tracked_paths(job["texts"], points, "adaptive", options)
+        out.update(retracked_adaptive=0, cpu_seconds=time.process_time() - cpu)
     else:
-        out = _track_texts(job["texts"], points, "double")
-        fields = [out[f] for f in ("codes", "finite", "singular")]
-        redo = sorted(
-            {
-                k
-                for k, (c, f, s) in enumerate(zip(*fields, strict=True))
-                if c != _SUCCESS or not f or s
-            }
-            | set(_twins(*fields, out["points"]))
-        )
+        out = double_then_adaptive(job["texts"], points, options)
+    return {**out, "seconds": time.perf_counter() - t0}
+
+
+def double_then_adaptive(
+    texts: tuple[str, str], points: np.ndarray, options: dict, singular_ok: bool = False
+) -> dict:
+    """The homotopy texts[0] (target texts[1]) from `points` in double precision, then in
+    adaptive precision every path that did not end at a finite point, that met another or
+    (unless `singular_ok`: a caller to whom a singular endpoint is no root it keeps, whose
+    retrack costs ~0.15 s for the same point) that ended singular. On a projective patch
+    (`options["projective"]`) a path that reached infinity inside the endgame (t < ENDGAME_T)
+    is not tracked again: a root escaping as t -> 0 grows like t^-a, past the max norm only
+    near t = 0, while a path past it earlier may be a finite root's (in affine coordinates
+    such a path fails in double precision instead, and its adaptive retrack costs 0.3-1 s:
+    the X-module's total-degree paths, monodromy's final homotopy). Every other failed path is
+    tracked again (without that the double pendulum's monodromy lost 550 of 1,700 paths), a
+    path Bertini flagged as crossing another (CROSSING, whatever its success code) among them."""
+    cpu = time.process_time()
+    out = tracked_paths(texts, points, "double", options)
+    fields = [out[f] for f in ("codes", "finite", "singular")]
+    patch = bool(options.get("projective"))
+    times = zip(out["codes"], out["times"], strict=True)
+    away = [patch and c in INFINITE_CODES and t < ENDGAME_T for c, t in times]
+    redo = {
+        k
+        for k, (c, f, sing) in enumerate(zip(*fields, strict=True))
+        if (c != _SUCCESS or not f or (sing and not singular_ok)) and not away[k]
+    }
+    redo = sorted(redo | set(_twins(*fields, out["points"])))
     if redo:
-        again = _track_texts(job["texts"], points[redo], "adaptive")
+        again = tracked_paths(texts, points[redo], "adaptive", options)
         for f in ("codes", "finite", "singular"):
             for k, i in enumerate(redo):
                 out[f][i] = again[f][k]
         out["points"][redo] = again["points"]
+    return {**out, "retracked_adaptive": len(redo), "cpu_seconds": time.process_time() - cpu}
+
+
+def tracked_paths(texts: tuple[str, str], points: np.ndarray, mptype: str, options: dict) -> dict:
+    """One HomotopySolver call (one thread unless `options["num_threads"]` says otherwise,
+    None: Bertini's default) with the step caps of track, each path's outcome the code it
+    stopped with (_code) and the t it stopped at; `options["projective"]`: on a patch
+    (parsed_system); "predictor" by name; the rest Bertini's settings."""
+    _bertini()  # recording off, before the import
+    from bertini import nag_algorithm as na
+    from bertini import tracking
+
+    options = {"num_threads": 1, **options}
+    if options["num_threads"] is None:
+        del options["num_threads"]
+    if "predictor" in options:  # by name here: the enum needs the module
+        options["predictor"] = getattr(tracking.Predictor, options["predictor"])
+    hom = parsed_system(texts[0], options.pop("projective", False))
+    solver = na.HomotopySolver(hom, list(points), parsed_system(texts[1]), mptype=mptype)
+    if mptype == "double":
+        solver.set(final_tolerance=DOUBLE_FINAL_TOLERANCE, max_num_steps=DOUBLE_MAX_STEPS)
+    else:
+        solver.set(max_num_steps=GENERIC_MAX_STEPS)
+    solver.set(**options)
+    quiet_solve(solver)  # our progress lines; no raw crossing line
+    meta = solver.solution_metadata()
     return {
-        **out,
-        "retracked_adaptive": len(redo),
-        "seconds": time.perf_counter() - t0,
-        "cpu_seconds": time.process_time() - cpu,
+        "codes": [_code(m) for m in meta],
+        "finite": [bool(m.is_finite) for m in meta],
+        "singular": [is_singular(m) for m in meta],
+        "times": [abs(complex(m.final_time_used)) for m in meta],
+        "points": _end_points(solver.all_solutions(), points.shape[1]),
     }
+
+
+@lru_cache(maxsize=16)
+def parsed_system(text: str, projective: bool = False):
+    """Bertini's parse of a system text, kept: a monodromy edge is tracked again and again, and
+    a parse of case 3's homotopy costs 3 ms (11 % of a run, measured); a solver does not change
+    the system it tracks (same endpoints from a kept parse and a fresh one, checked).
+
+    `projective`: homogenized (one homogenizing variable per variable group: multiprojective)
+    on a patch drawn from a fixed seed (Bertini's own homogenization; its solver dehomogenizes
+    the endpoints), for homotopies whose paths mostly go to infinity: in affine coordinates
+    double precision fails on them near t = 0 (296 of the prism's 343 paths of monodromy's
+    final homotopy) and each costs a 0.27 s adaptive retrack (83 s of a 122 s run); on a patch
+    they end at infinity in double precision (that final homotopy 3.2 s, the same 22 roots)."""
+    bertini = _bertini()
+    system = bertini.parse.system(text)
+    if not projective:
+        return system
+    from bertini import system as bsys
+
+    bertini.random.set_random_seed(PATCH_SEED)  # the same patch on every run
+    system = bsys.clone(system)
+    system.homogenize()
+    system.auto_patch()
+    return system
 
 
 def route_record(sets: list[GenericSet], scheduler: str | None) -> dict:

@@ -40,10 +40,11 @@ what each step relies on (the proof obligations):
    points escape to infinity.
 5. The generic set: one parameter homotopy from (c0, e0) to (0, 0) with a random complex detour
    (the gamma trick), on a random patch of projective space (most of its paths go to
-   infinity: `_parsed`), tracks the complete fibre to F(x; p0) = 0. By the parameter continuation
-   theorem its endpoints include every isolated solution of F(x; p0); the finite nonsingular
-   ones are the generic set, as the total-degree route keeps them. All paths go along one
-   curve (paths along two curves may not be mixed: they differ by a monodromy permutation).
+   infinity: `homotopy.parsed_system`), tracks the complete fibre to F(x; p0) = 0. By the
+   parameter continuation theorem its endpoints include every isolated solution of F(x; p0);
+   the finite nonsingular ones are the generic set, as the total-degree route keeps them. All
+   paths go along one curve (paths along two curves may not be mixed: they differ by a
+   monodromy permutation).
    A second run along another random detour checks the first: a path that jumps onto another
    path's way to infinity loses a root and shows nothing, but two runs would have to lose the
    same one; the set is complete only when both end at the same roots.
@@ -63,7 +64,6 @@ from __future__ import annotations
 import json
 import time
 from dataclasses import dataclass, field
-from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -73,24 +73,16 @@ from ..fs import atomic_write_text
 from ..model.polynomial import ParametricSystem, PolySystem
 from ..progress import Progress, say
 from ..versions import bertini2_version
-from .crossings import solve as quiet_solve
 from .homotopy import (
     _SUCCESS,
     BERTINI_MAX_NORM,
-    DOUBLE_FINAL_TOLERANCE,
-    DOUBLE_MAX_STEPS,
-    GENERIC_MAX_STEPS,
     INFINITE_CODES,
     NEVER_TRACKED,
     START_CENTRE,
     GenericSet,
-    _bertini,
-    _code,
-    _end_points,
-    _twins,
     coincident_rows,
+    double_then_adaptive,
     generic_start,
-    is_singular,
     solver_errors,
 )
 from .neighbour import _newton
@@ -121,8 +113,6 @@ FINAL_MAX_NORM = BERTINI_MAX_NORM  # the final homotopy: its paths do go to infi
 FINAL_ATTEMPTS = 3  # the final homotopy with a new detour when a path of it is lost
 PENCIL_STEP = 3.0  # |s1|, |s2| about this: node B (s1) far enough from A that a loop through
 # edge 0 and another edge is a fat triangle, not a sliver (B near A: roots stopped coming)
-ENDGAME_T = 0.1  # Bertini's endgame boundary: a path at infinity before this is retracked
-PATCH_SEED = 2028  # Bertini's random patch of the projective final homotopy
 CHECKPOINT_SECONDS = 10.0  # the working state is written at most this often
 CHUNK = 128  # paths a Bertini call on an edge: the checkpoint and progress between them
 M, E = "mono_m", "mono_e"  # parameter names of the augmented family (unlike any variable)
@@ -259,7 +249,7 @@ def track_segment(
         render_system(aug.system(target)),
     )
     points = np.asarray(points, dtype=complex)
-    if singular_ok:  # the final homotopy, tracked in projective space: see _parsed
+    if singular_ok:  # the final homotopy, tracked in projective space: see homotopy.parsed_system
         # Bertini's 2 Newton iterations here: with 4 the four-bar's final homotopy ended 28
         # of its 30 roots (two paths jumped, to infinity: nothing to notice it by; measured)
         options = {"max_norm": FINAL_MAX_NORM, "projective": True}
@@ -271,7 +261,7 @@ def track_segment(
             "max_num_newton_iterations": LOOP_NEWTON,
         }
     with solver_errors(f"a monodromy path batch ({len(points)} paths)"):
-        out = _double_then_adaptive(texts, points, singular_ok, options)
+        out = double_then_adaptive(texts, points, options, singular_ok)
     ok = np.array(
         [
             c == _SUCCESS and f and not s
@@ -292,99 +282,6 @@ def track_segment(
         out["retracked_adaptive"],
         out["cpu_seconds"],
     )
-
-
-def _double_then_adaptive(
-    texts: tuple[str, str], points: np.ndarray, singular_ok: bool, options: dict
-) -> dict:
-    """The homotopy texts[0] (target texts[1]) from `points` in double precision, then in
-    adaptive precision every path that did not end at a finite point, that met another or
-    (unless `singular_ok`) that ended singular: homotopy.track_chunk's policy, but (a) the final
-    homotopy's singular endpoints (the d = 0 artefacts, say) are not tracked again: they are
-    not part of the generic set, and a retrack costs ~0.15 s each for the same point; (b) nor
-    are its paths that went to infinity inside the endgame (t < ENDGAME_T): a root escaping as
-    the parameters reach (0, 0) grows like t^-a, past the max norm only near t = 0, while a
-    path that passes 1e5 earlier may be a finite root's and is tracked again (on the double
-    pendulum 31 retracks fewer, of 150, and the same set);
-    (c) a path's outcome is read before the endgame too (_bertini_paths). `options`: more
-    settings. (Every failed path of an edge is tracked again too: without that the double
-    pendulum's search lost 550 of 1,700 paths and stalled 1 to 3 roots short, measured.)"""
-    cpu = time.process_time()
-    out = _bertini_paths(texts, points, "double", options)
-    fields = [out[f] for f in ("codes", "finite", "singular")]
-    times = zip(out["codes"], out["times"], strict=True)
-    away = [c in INFINITE_CODES and t < ENDGAME_T for c, t in times]
-    redo = {
-        k
-        for k, (c, f, sing) in enumerate(zip(*fields, strict=True))
-        if (c != _SUCCESS or not f or (sing and not singular_ok)) and not (singular_ok and away[k])
-    }
-    redo = sorted(redo | set(_twins(*fields, out["points"])))
-    if redo:
-        # Affine, as tracked: on a projective patch the double pendulum's 67 edge retracks took
-        # 8 s, not 25 s, but the prism's 90 took 17 s, not 8 s, and the four-bar's search lost
-        # a root (203 of 204, trace defect 3.9e-7; measured)
-        again = _bertini_paths(texts, points[redo], "adaptive", options)
-        for f in ("codes", "finite", "singular"):
-            for k, i in enumerate(redo):
-                out[f][i] = again[f][k]
-        out["points"][redo] = again["points"]
-    return {**out, "retracked_adaptive": len(redo), "cpu_seconds": time.process_time() - cpu}
-
-
-def _bertini_paths(texts: tuple[str, str], points: np.ndarray, mptype: str, options: dict) -> dict:
-    """One HomotopySolver call on one thread with the step caps of homotopy._track_texts, each
-    path's outcome the code it stopped with: Bertini leaves the endgame's code NeverStarted
-    when a path stopped before the endgame, where GoingToInfinity is a path at infinity (seen
-    on the double pendulum's final homotopy), not a lost one."""
-    _bertini()  # recording off, before the import
-    from bertini import nag_algorithm as na
-    from bertini import tracking
-
-    if "predictor" in options:  # by name here: the enum needs the module
-        options = {**options, "predictor": getattr(tracking.Predictor, options["predictor"])}
-    options = dict(options)
-    hom, target = _parsed(texts[0], options.pop("projective", False)), _parsed(texts[1])
-    solver = na.HomotopySolver(hom, list(points), target, mptype=mptype)
-    if mptype == "double":
-        solver.set(final_tolerance=DOUBLE_FINAL_TOLERANCE, max_num_steps=DOUBLE_MAX_STEPS)
-    else:
-        solver.set(max_num_steps=GENERIC_MAX_STEPS)
-    solver.set(num_threads=1, **options)
-    quiet_solve(solver)
-    meta = solver.solution_metadata()
-    return {
-        "codes": [_code(m) for m in meta],
-        "finite": [bool(m.is_finite) for m in meta],
-        "singular": [is_singular(m) for m in meta],
-        "times": [abs(complex(m.final_time_used)) for m in meta],
-        "points": _end_points(solver.all_solutions(), points.shape[1]),
-    }
-
-
-@lru_cache(maxsize=16)
-def _parsed(text: str, projective: bool = False):
-    """Bertini's parse of a system text, kept: an edge is tracked again and again, and a parse
-    of case 3's homotopy costs 3 ms (11 % of a run, measured); a solver does not change the
-    system it tracks (same endpoints from a kept parse and a fresh one, checked).
-
-    `projective`: homogenized on a patch drawn from a fixed seed (Bertini's own homogenization;
-    its solver dehomogenizes the endpoints). For the final homotopy, whose paths mostly go to
-    infinity: in affine coordinates double precision fails on them near t = 0 (296 of the
-    prism's 343 paths) and each costs a 0.27 s adaptive retrack (83 s of a 122 s run); on a
-    patch they end at infinity in double precision (the prism's whole final homotopy 3.2 s,
-    the same 22 roots)."""
-    bertini = _bertini()
-    system = bertini.parse.system(text)
-    if not projective:
-        return system
-    from bertini import system as bsys
-
-    bertini.random.set_random_seed(PATCH_SEED)  # the same patch on every run
-    system = bsys.clone(system)
-    system.homogenize()
-    system.auto_patch()
-    return system
 
 
 def _polish(system: PolySystem, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

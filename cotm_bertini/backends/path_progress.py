@@ -4,16 +4,13 @@ paths finish.
 A first guess of the seconds a path comes from the best thing known in this process: the rate
 of an earlier solve of the same system (the second generic set of a framework's taut set
 follows its first), a rate measured on sample paths (api.costs, before a framework solve), or
-PRIOR_SECONDS_PER_PATH. Once the solve runs, Bertini's ZeroDimSolver reports every finished
-path to an observer (the seam its own progress bar uses), so the rate and the time left shown
-are measured on this solve's paths.
+PRIOR_SECONDS_PER_PATH. Once the solve runs, each chunk of its paths reports as it comes back
+(homotopy._own_solve), so the rate and the time left shown are measured on this solve's paths.
 """
 
 from __future__ import annotations
 
 import json
-from collections.abc import Iterator
-from contextlib import contextmanager
 
 from ..progress import Progress
 
@@ -57,50 +54,6 @@ def expected(ps, groups) -> tuple[int, float, str]:
     solve of `ps` with `groups`, before it starts."""
     rate, source = first_guess(ps, groups)
     return path_count(ps, groups), rate, source
-
-
-def _observer_class():
-    from bertini._pybertini.nag_algorithms import observers
-
-    class PathObserver(observers.CustomObserver):
-        """Forwards each finished path of a solve to a Progress, with a tally of outcomes."""
-
-        def __init__(self, report: Progress):
-            super().__init__()
-            self.report = report
-            self.tally = {"going to infinity": 0, "failed": 0}
-
-        def Observe(self, event) -> None:  # noqa: N802 (Bertini's name)
-            try:  # called from the solver's threads: a report must never fail the solve
-                if type(event).__name__ != "PathComplete":
-                    return
-                total = self.report.total
-                if total is not None and self.report.done >= total:
-                    return  # (a path tracked again after a crossing is not one more path)
-                code = str(getattr(event.outcome(), "name", event.outcome()))
-                if code in ("GoingToInfinity", "SecurityMaxNormReached"):
-                    self.tally["going to infinity"] += 1
-                elif code != "Success":
-                    self.tally["failed"] += 1
-                note = ", ".join(f"{n} {k}" for k, n in self.tally.items() if n)
-                self.report.update(1, note=note or None)
-            except Exception:
-                pass
-
-    return PathObserver
-
-
-@contextmanager
-def watched(solver, report: Progress) -> Iterator[None]:
-    """`report` advanced by every path `solver` finishes inside the block (a ZeroDimSolver or
-    HomotopySolver of the bertini module); the observer is held until it is removed (the
-    solver does not own it)."""
-    observer = _observer_class()(report)
-    solver.add_observer(observer)
-    try:
-        yield
-    finally:
-        solver.remove_observer(observer)
 
 
 def generic_report(seed: int, paths: int, announced: bool) -> Progress:

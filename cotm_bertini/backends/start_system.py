@@ -51,6 +51,12 @@ class LinearProductStart:
 
         yield from extend(0)
 
+    @property
+    def declared(self) -> list[int]:
+        """The variables' indices in the order the homotopy text declares them (group by
+        group): Bertini's order of a point's coordinates."""
+        return [k for g in self.groups for k in g]
+
     def count(self) -> int:
         """The multihomogeneous Bezout number: how many roots `points` yields."""
         rows = np.arange(len(self.degrees))
@@ -135,11 +141,13 @@ def linear_product_start(
 
 def gamma_homotopy_text(system: PolySystem, start: LinearProductStart, gamma: complex) -> str:
     """INPUT section of H = (1 - t) F + gamma t G (F: `system`, with its subfunctions if it has
-    them, G: `start`), one affine group."""
+    them, G: `start`), one variable group for each of the start's groups (in that order:
+    `start.declared`), so that H is multihomogeneous of F's multidegree and can be tracked on
+    a multiprojective patch (homotopy.parsed_system)."""
     funcs = function_texts(system)
     lines = [
         "INPUT",
-        f"variable_group {', '.join(system.variables)};",
+        *(f"variable_group {', '.join(system.variables[k] for k in g)};" for g in start.groups),
         "pathvariable t;",
         f"function {', '.join(system.names)};",
         *subfunction_lines(system.structured),

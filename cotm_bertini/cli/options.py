@@ -79,10 +79,12 @@ def add_route(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--generic",
         choices=("monodromy", "total-degree", "both"),
-        help="how a generic solution set is found: monodromy, trace-tested (default; after "
-        "a failed trace test the default falls back to total-degree); Bertini's total-degree "
-        "start, two seeds agree (the route with --scheduler); or both (the monodromy set "
-        "checked against the total-degree one)",
+        help="how a generic solution set is found: monodromy, trace-tested; total-degree, "
+        "a start tracked on a projective patch, two seeds agree (the route with --scheduler); "
+        "or both (the monodromy set checked against the total-degree one). Default: for a "
+        "framework's taut set, total-degree when its two seeds track at most 5,000 paths, "
+        "else monodromy (params --framework says which and why); the paper's mechanism by "
+        "monodromy; after a failed trace test the default falls back to total-degree",
     )
     p.add_argument(
         "--route",

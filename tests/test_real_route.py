@@ -272,3 +272,57 @@ def test_unbounded_products_stay_sound():
     assert p.lo[2] <= -4.0 and p.hi[2] >= 8.0
     assert b.lo[2] == -inf and b.hi[2] == inf  # 1 / [-0.5, 0.5]
     assert (a + Interval(np.full(3, -inf), np.full(3, inf))).hi[0] == inf
+
+
+# --- a map on the real route ---------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def xmodule_map(tmp_path_factory):
+    """The X-module's 5 x 5 map over (L0c, fy) in a fresh cache: the real route's fold and
+    switch seeds (no generic set is solved: none may appear in the cache)."""
+    import os
+
+    cache = tmp_path_factory.mktemp("cache")
+    before = os.environ.get("COTM_CACHE")
+    os.environ["COTM_CACHE"] = str(cache)
+    try:
+        fw = cb.Framework.from_toml(XMODULE)
+        m = cb.design_map(fw, "L0c", (1.0, 1.6), "fy", (-0.2, -0.05), points=5)
+    finally:
+        if before is None:
+            del os.environ["COTM_CACHE"]
+        else:
+            os.environ["COTM_CACHE"] = before
+    return m, cache
+
+
+def test_a_map_on_the_real_route_solves_no_generic_set(xmodule_map):
+    m, cache = xmodule_map
+    assert not list(cache.glob("generic-*"))
+    assert m.record["status"] == "ok"
+    kinds = set(m.folds["kind"])
+    assert {"fold", "cable_switch"} <= kinds
+
+
+def test_the_maps_folds_and_switches_against_the_independent_energy(xmodule_map):
+    """Every fold point is critical for the energy written here, with a singular Hessian;
+    every switch point has a cable exactly at its free length and is critical."""
+    m, _ = xmodule_map
+    f = m.folds
+    h = 1e-6
+    for kind in ("fold", "cable_switch"):
+        rows = f[f["kind"] == kind].iloc[::25]
+        assert len(rows)
+        for _, r in rows.iterrows():
+            values = {"L0c": r["L0c"], "fy": r["fy"]}
+            t = np.radians([[r["bar1.angle_deg"], r["bar2.angle_deg"]]])
+            _, g = _x_energy(t, **values)
+            assert np.abs(g).max() < 1e-7, (kind, r["L0c"], r["fy"])
+            tip1 = np.array([r["bar1.tip.x"], r["bar1.tip.y"]])
+            tip2 = np.array([r["bar2.tip.x"], r["bar2.tip.y"]])
+            gaps = [np.linalg.norm(tip1 - [1.0, 0.0]) - r["L0c"], np.linalg.norm(tip2) - r["L0c"]]
+            if kind == "cable_switch":
+                assert min(abs(v) for v in gaps) < 1e-8
+            else:
+                H = np.stack([(_x_energy(t + h * e, **values)[1] - _x_energy(t - h * e,
+                              **values)[1])[0] / (2 * h) for e in np.eye(2)])  # fmt: skip
+                assert abs(np.linalg.det(H)) < 1e-5 * np.abs(H).max() ** 2 + 1e-7

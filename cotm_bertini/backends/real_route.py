@@ -254,7 +254,7 @@ class TorusFramework:
         )  # fmt: skip
 
 
-def critical_seeds(land: TorusFramework, boxes: np.ndarray, most: int = 64) -> np.ndarray:
+def critical_seeds(land: TorusFramework, boxes: np.ndarray, most: int = 32) -> np.ndarray:
     """Critical points near undecided boxes (lo_1..lo_n, hi_1..hi_n): Newton with a
     least-squares step (the Hessian may be singular there: a continuum) from the middles of at
     most `most` of them, spread over the list; the ends where |grad V| < 1e-10."""
@@ -263,9 +263,14 @@ def critical_seeds(land: TorusFramework, boxes: np.ndarray, most: int = 64) -> n
         return np.zeros((0, n))
     pick = boxes[np.unique(np.linspace(0, len(boxes) - 1, min(most, len(boxes))).astype(int))]
     x = 0.5 * (pick[:, :n] + pick[:, n:])
-    for _ in range(30):
-        g, h = land.derivatives(x)
-        x = x - np.einsum("nij,nj->ni", np.linalg.pinv(h, rcond=1e-10), g)
+    live = np.arange(len(x))
+    for _ in range(30):  # the points still moving only: most converge in a few steps
+        g, h = land.derivatives(x[live])
+        step = np.einsum("nij,nj->ni", np.linalg.pinv(h, rcond=1e-10), g)
+        x[live] -= step
+        live = live[np.isfinite(step).all(axis=1) & (np.abs(step).max(axis=1) > 1e-13)]
+        if not len(live):
+            break
     g, _ = land.derivatives(x)
     return x[np.isfinite(g).all(axis=1) & (np.abs(g).max(axis=1) < 1e-10)]
 

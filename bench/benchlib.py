@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import subprocess
+import sys
+import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -184,3 +186,12 @@ def same_points(a: np.ndarray, b: np.ndarray, tol: float = 1e-8) -> bool:
             return False
         left.pop(int(np.argmin(d)))
     return True
+
+
+def cli_seconds(args: list[str], env: dict) -> float:
+    """Seconds of one `cotm-bertini` run end to end (no cache of results, no figures)."""
+    cli = str(Path(sys.executable).with_name("cotm-bertini"))
+    t0 = time.perf_counter()
+    subprocess.run([cli, *args, "--no-cache", "--no-plots", "--quiet"], check=True, env=env,
+                   cwd=tempfile.mkdtemp(), capture_output=True)  # fmt: skip
+    return time.perf_counter() - t0

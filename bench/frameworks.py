@@ -9,14 +9,13 @@ from __future__ import annotations
 
 import argparse
 import os
-import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
 import pandas as pd
-from benchlib import BENCH, show, write_csv
+from benchlib import BENCH, cli_seconds, show, write_csv
 
 ROOT = BENCH.parent
 CLI = str(Path(sys.executable).with_name("cotm-bertini"))
@@ -30,21 +29,13 @@ EXAMPLES = {
 }
 
 
-def _run(args: list[str], env: dict) -> float:
-    """Seconds of one CLI run (no cache of results, no figures)."""
-    t0 = time.perf_counter()
-    subprocess.run([CLI, *args, "--no-cache", "--no-plots", "--quiet"], check=True, env=env,
-                   cwd=tempfile.mkdtemp(), capture_output=True)  # fmt: skip
-    return time.perf_counter() - t0
-
-
 def _row(name: str, env: dict, route: str | None) -> dict:
     import cotm_bertini as cb
 
     args = ["solve", "--framework", str(ROOT / "examples" / f"{name}.toml"), *EXAMPLES[name]]
     args += ["--generic", route] if route else []
-    first = _run(args, env)
-    later = min(_run(args, env) for _ in range(3))
+    first = cli_seconds(args, env)
+    later = min(cli_seconds(args, env) for _ in range(3))
     os.environ["COTM_CACHE"] = env["COTM_CACHE"]
     fw = cb.Framework.from_toml(ROOT / "examples" / f"{name}.toml")
     sets = dict(a.split("=") for a in EXAMPLES[name][1::2])
@@ -75,7 +66,7 @@ def main() -> None:
         if name not in opts.skip:
             rows.append(_row(name, env, opts.generic))
             print(rows[-1], file=sys.stderr, flush=True)
-    builtin = min(_run(["solve", "case3"], env) for _ in range(3))
+    builtin = min(cli_seconds(["solve", "case3"], env) for _ in range(3))
     frame = pd.DataFrame(rows)
     show("frameworks: CLI solve, end to end (s); cb.barriers of the solve (s)", frame,
          {"first_solve_s": ".1f", "first_over_later": ".1f", "barriers_s": ".2f"})  # fmt: skip

@@ -8,18 +8,14 @@ from __future__ import annotations
 
 import argparse
 import os
-import subprocess
-import sys
 import tempfile
 import time
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from benchlib import BENCH, show, write_csv
+from benchlib import BENCH, cli_seconds, show, write_csv
 
 ROOT = BENCH.parent
-CLI = str(Path(sys.executable).with_name("cotm-bertini"))
 EXAMPLES = {
     "xmodule": [],
     "chain3": [],
@@ -28,14 +24,6 @@ EXAMPLES = {
     "double_pendulum": [],
     "cotm": [],
 }
-
-
-def _run(args: list[str], env: dict) -> float:
-    """Seconds of one CLI run (no cache of results, no figures)."""
-    t0 = time.perf_counter()
-    subprocess.run([CLI, *args, "--no-cache", "--no-plots", "--quiet"], check=True, env=env,
-                   cwd=tempfile.mkdtemp(), capture_output=True)  # fmt: skip
-    return time.perf_counter() - t0
 
 
 def _search_cpu(fw) -> tuple[int, float, int]:
@@ -56,8 +44,8 @@ def _row(name: str) -> dict:
 
     env = {**os.environ, "COTM_CACHE": tempfile.mkdtemp(prefix="cotm-bench-real-")}
     args = ["solve", "--framework", str(ROOT / "examples" / f"{name}.toml"), *EXAMPLES[name]]
-    first = _run(args, env)
-    later = min(_run(args, env) for _ in range(3))
+    first = cli_seconds(args, env)
+    later = min(cli_seconds(args, env) for _ in range(3))
     os.environ["COTM_CACHE"] = env["COTM_CACHE"]
     fw = cb.Framework.from_toml(ROOT / "examples" / f"{name}.toml")
     sets = dict(a.split("=") for a in EXAMPLES[name][1::2])

@@ -174,20 +174,30 @@ def test_the_api_refuses_them_too():
         cb.Params(L02=1e15)
 
 
-def test_a_bertini_failure_is_one_solver_error_naming_what_was_solved():
-    """A positive-dimensional system (f2 = 2 f1): Bertini's own RuntimeError becomes a
-    SolverError that names the generic solve, in one line."""
+def test_a_bertini_failure_is_one_solver_error_naming_what_was_solved(monkeypatch):
+    """A positive-dimensional system (f2 = 2 f1): the projective total-degree route ends every
+    path at a singular point (no root kept, said in the record); and Bertini's own RuntimeError
+    (raised here by the tracker, as Bertini raises it on a system it cannot parse or start)
+    becomes a SolverError that names the generic solve, in one line."""
     import sympy as sp
 
     import cotm_bertini as cb
-    from cotm_bertini.backends.homotopy import generic_set
+    from cotm_bertini.backends import homotopy
     from cotm_bertini.model.symbolic import parametric_from_sympy
 
     x, y, p = sp.symbols("x y p")
     f = x * y - p
     ps = parametric_from_sympy(("x", "y"), ("f1", "f2"), (f, 2 * f), ("p",))
+    gs = homotopy.generic_set(ps, seed=3, use_cache=False, centre={"p": 1.0})
+    assert gs.summary()["singular_endpoints"] == gs.summary()["paths"] == 4
+    assert gs.summary()["tracked_points"] == 0
+
+    def fails(*args, **kwargs):
+        raise RuntimeError("Bertini stopped: the start system has no nonsingular point")
+
+    monkeypatch.setattr(homotopy, "tracked_paths", fails)
     with pytest.raises(cb.SolverError) as err:
-        generic_set(ps, seed=3, use_cache=False, centre={"p": 1.0})
+        homotopy.generic_set(ps, seed=3, use_cache=False, centre={"p": 1.0})
     text = str(err.value)
     assert "generic solution set" in text and "Bertini stopped" in text and "\n" not in text
     assert isinstance(err.value.__cause__, RuntimeError)

@@ -231,11 +231,13 @@ def cone_points(fw: Framework, near: np.ndarray | None = None) -> list[dict]:
 def _cones_near(fw: Framework, ps, slots_n: dict, near: np.ndarray) -> np.ndarray:
     """The zero-length poses of one spring (system `ps`) that Newton reaches from the middles of
     the boxes `near` (lo1, lo2, hi1, hi2 rad), each once."""
+    from ..backends.real_route import coarse_pick
     from ..model.framework.structure import layout
     from .refine import newton_refine
 
     bodies = layout(fw).rotations
     n = len(bodies)
+    near = coarse_pick(near, 64) if len(near) else near  # one a cell: each cone point's cluster
     mid = 0.5 * (near[:, :n] + near[:, n:]) if len(near) else np.zeros((0, n))
     x0 = np.zeros((len(mid), len(ps.variables)), dtype=complex)
     for k, v in enumerate(ps.variables):

@@ -173,12 +173,11 @@ class TorusFramework:
         first = self.full.numeric.first_order(self._numeric_pose(self.full, x), P)
         dim, m, per = self.fw.dim, self.n, self.fw.dim + self.fw.dim * self.n
         grad = np.zeros((len(x), m))
-        grad += np.stack([np.broadcast_to(v, (len(x),)) for v in first[len(self.links) * per:]],
-                         axis=1) if m else 0.0  # fmt: skip
+        grad += _columns(first[len(self.links) * per :], len(x)) if m else 0.0
         taut = np.ones((len(x), len(self.cables)), dtype=bool)
         for i, link in enumerate(self.links):
-            block = [np.broadcast_to(v, (len(x),)) for v in first[i * per : (i + 1) * per]]
-            r, dr = np.stack(block[:dim], axis=1), np.stack(block[dim:], axis=1)
+            block = _columns(first[i * per : (i + 1) * per], len(x))
+            r, dr = block[:, :dim], block[:, dim:]
             d = np.sqrt((r * r).sum(axis=1))
             a = np.einsum("nc,ncj->nj", r, dr.reshape(len(x), dim, m))
             w = np.full(len(x), link.k) if link.L0 is None else link.k * (1 - link.L0 / d)
@@ -193,8 +192,7 @@ class TorusFramework:
             rows = np.flatnonzero((taut == want).all(axis=1))
             if len(rows):
                 h = fs.numeric.hessian(self._numeric_pose(fs, x[rows]), P)
-                hess[rows] = np.stack([np.broadcast_to(v, (len(rows),)) for v in h],
-                                      axis=1).reshape(-1, m, m)  # fmt: skip
+                hess[rows] = _columns(h, len(rows)).reshape(-1, m, m)
         return grad, hess
 
     def _numeric_pose(self, fs: FrameworkSystem, x: np.ndarray) -> np.ndarray:
@@ -255,13 +253,13 @@ class TorusFramework:
 
 
 def critical_seeds(land: TorusFramework, boxes: np.ndarray, most: int = 32) -> np.ndarray:
-    """Critical points near undecided boxes (lo_1..lo_n, hi_1..hi_n): Newton with a
-    least-squares step (the Hessian may be singular there: a continuum) from the middles of at
-    most `most` of them, spread over the list; the ends where |grad V| < 1e-10."""
+    """Critical points near undecided or set-aside boxes (lo_1..lo_n, hi_1..hi_n): Newton with
+    a least-squares step (the Hessian may be singular there: a continuum) from the middles of
+    at most `most` of them (`coarse_pick`); the ends where |grad V| < 1e-10."""
     n = land.n
     if not len(boxes):
         return np.zeros((0, n))
-    pick = boxes[np.unique(np.linspace(0, len(boxes) - 1, min(most, len(boxes))).astype(int))]
+    pick = coarse_pick(boxes, most)
     x = 0.5 * (pick[:, :n] + pick[:, n:])
     live = np.arange(len(x))
     for _ in range(30):  # the points still moving only: most converge in a few steps
@@ -294,6 +292,26 @@ def real_equilibria(fw: Framework) -> tuple[dict[tuple[str, ...], Endpoints], Bo
     land = TorusFramework(fw)
     found = search(land, SHORT, MIN_WIDTH, label=f"real search of {fw.name}")
     return {tuple(sorted(k)): v for k, v in land.endpoints(found.roots).items()}, found
+
+
+def _columns(values: list, count: int) -> np.ndarray:
+    """Generated code's outputs (arrays of `count`, or constants) as the columns of one array."""
+    out = np.empty((count, len(values)))
+    for k, v in enumerate(values):
+        out[:, k] = v
+    return out
+
+
+def coarse_pick(boxes: np.ndarray, most: int, cell: float = 0.02) -> np.ndarray:
+    """At most `most` of the boxes (lo_1..lo_n, hi_1..hi_n), one a cell of `cell` rad of their
+    middles, spread over the list: every cluster of boxes (one around each cone point or along
+    a continuum) is seeded, not just the largest."""
+    n = boxes.shape[1] // 2
+    mid = 0.5 * (boxes[:, :n] + boxes[:, n:])
+    _, first = np.unique(np.floor(mid / cell).astype(np.int64), axis=0, return_index=True)
+    first = np.sort(first)
+    return boxes[first[np.unique(np.linspace(0, len(first) - 1, min(most, len(first)))
+                                 .astype(int))]]  # fmt: skip
 
 
 def _sum(items) -> Interval:

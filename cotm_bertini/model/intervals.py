@@ -217,6 +217,8 @@ def stack(items: list, axis: int = -1) -> Interval:
     """Intervals (or numbers) of one shape stacked along a new axis."""
     items = [Interval.of(v) for v in items]
     shape = np.broadcast_shapes(*(np.shape(v.lo) for v in items))
-    lo = np.stack([np.broadcast_to(v.lo, shape) for v in items], axis=axis)
-    hi = np.stack([np.broadcast_to(v.hi, shape) for v in items], axis=axis)
+    lo = np.stack([v.lo if v.lo.shape == shape else np.broadcast_to(v.lo, shape)
+                   for v in items], axis=axis)  # fmt: skip
+    hi = np.stack([v.hi if v.hi.shape == shape else np.broadcast_to(v.hi, shape)
+                   for v in items], axis=axis)  # fmt: skip
     return Interval(lo, hi)

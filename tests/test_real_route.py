@@ -184,16 +184,21 @@ def test_cotm_file_on_the_real_route_equals_the_papers_model(case):
 
 
 @pytest.mark.parametrize(
-    "name, values", [("zeeman", {"x": 0.1, "y": -0.25}), ("zeeman_cables", {"x": 1.45, "y": 0.2})]
-)
+    "name, values",
+    [("zeeman", {"x": 0.1, "y": -0.25}), ("zeeman_cables", {"x": 1.45, "y": 0.2}),
+     ("double_pendulum", {}), ("cotm", {})],
+)  # fmt: skip
 def test_real_and_complex_routes_give_the_same_physical_rows(name, values):
+    """Every shipped torus example with an affordable complex solve (the X-module's, 27 s, is
+    in `make stress`; chain3's is out of reach): the same rows, poses to 1e-8 deg."""
     fw = cb.Framework.from_toml(ROOT / "examples" / f"{name}.toml").replace(**values)
     real, cplx = cb.solve(fw, route="real"), cb.solve(fw, route="complex")
     assert real.status == cplx.status == "ok"
-    cols = ["wheel.angle_deg", "energy", "index"]
+    cols = [c for c in real.physical.columns if c.endswith(".angle_deg")] + ["energy", "index"]
     a, b = real.physical[cols].to_numpy(float), cplx.physical[cols].to_numpy(float)
     assert a.shape == b.shape
-    np.testing.assert_allclose(a, b, atol=1e-8)
+    gap = np.abs((a - b + 180.0) % 360.0 - 180.0)
+    assert gap[:, :-2].max() < 1e-8 and np.abs(a[:, -2:] - b[:, -2:]).max() < 1e-8
 
 
 # --- what the search cannot decide, and a sabotaged search -------------------------------------

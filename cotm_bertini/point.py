@@ -17,6 +17,7 @@ import numpy as np
 
 from .analysis.classify import classify_columns
 from .analysis.morse import morse_check
+from .backends.boxes import MIN_WIDTH
 from .backends.crossings import in_solve
 from .backends.endpoints import Endpoints
 from .errors import ParameterError
@@ -284,7 +285,7 @@ def _solve_real(fw, settings: Settings, tolerances: Tolerances, t: Timings) -> P
     curve no box can be decided), traced and counted apart as on the complex route."""
     from .analysis.framework_checks import completeness, framework_counts, order_rows
     from .analysis.framework_continua import absorb, continuum_record, find_continua
-    from .backends.boxes import MIN_WIDTH, SHORT, search
+    from .backends.boxes import SHORT, search
     from .backends.real_route import TorusFramework, critical_seeds, fresh_points
     from .model.framework.compiled import check_terms
     from .model.framework.units import normalized_slots, units
@@ -360,11 +361,8 @@ def along_continua(land, found, continua: list) -> int:
         pts = np.radians(np.stack([c.columns[f"{b}.angle_deg"] for b in land.bodies], axis=1))
         gap = lambda a, b: np.abs((a - b + np.pi) % (2 * np.pi) - np.pi).max(axis=-1)  # noqa: E731
         step = gap(pts[1:], pts[:-1]).max() if len(pts) > 1 else 0.0
-        near |= gap(mid[:, None, :], pts[None]).min(axis=1) <= step + 2 * MIN_WIDTH_RAD
+        near |= gap(mid[:, None, :], pts[None]).min(axis=1) <= step + 2 * MIN_WIDTH
     return int(near.sum())
-
-
-MIN_WIDTH_RAD = 1e-4  # the real search's smallest box (backends.boxes.MIN_WIDTH)
 
 
 def real_search_info(found, length_unit: float, along: int = 0, morse_bott: bool = False) -> dict:
@@ -386,7 +384,7 @@ def real_search_info(found, length_unit: float, along: int = 0, morse_bott: bool
         # at every traced point: the continuum's Morse index) the Morse-Bott lemma leaves no
         # other critical point near it; where that index is unknown the boxes stay a warning.
         (notes if morse_bott else warnings).append(
-            f"{along} boxes of the real search (no wider than {MIN_WIDTH_RAD:g} rad) lie along "
+            f"{along} boxes of the real search (no wider than {MIN_WIDTH:g} rad) lie along "
             "the continua of equilibria and stay undecided (V is constant along a continuum)"
             + ("; no other equilibrium lies there by the Morse-Bott lemma (each continuum's "
                "Hessian across it nondegenerate at its traced points)" if morse_bott else

@@ -62,7 +62,10 @@ def sweep_seeds(
     solved: dict = {}
     tasks = [(fw, cs, spec, ts, names, settings) for spec in vertical]
     stage = f"{what}: equilibria at {len(vertical)} x {len(ts)} crossings, by vertical line"
-    for part in run_reported(run, _solve_line, tasks, stage, "lines", batch):
+    # On the real route a crossing's search serves every curve system of the map (kept in this
+    # process, real_route.real_equilibria): searched here, once, not in a worker each time.
+    real = framework_route(fw, settings) == "real"
+    for part in run_reported(_here if real else run, _solve_line, tasks, stage, "lines", batch):
         solved.update(part)
     tasks = [(cs, spec, ts, [solved[_key(spec, t)] for t in ts]) for spec in specs]
     stage = f"{what}: branches and their turns along the seed lines"
@@ -72,6 +75,11 @@ def sweep_seeds(
         seeds += found
         lines.append(record)
     return seeds, lines
+
+
+def _here(fn, tasks: list) -> list:
+    """Run the tasks in this process (a `Run`'s signature)."""
+    return [fn(task) for task in tasks]
 
 
 def _samples(specs: list) -> int:

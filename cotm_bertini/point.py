@@ -138,6 +138,7 @@ def solve_point(
     and leaves its files there; the homotopy engine writes nothing. `warm` (the `warm` of a
     neighbouring point's solution) lets the homotopy engine continue from that point.
     """
+    check_route(params, settings)
     t = Timings()
     with t.stage("derive"):
         ps = parametric_system(params.zfl)
@@ -262,6 +263,19 @@ def solve_framework_point(
         engine, shape, {"taut_sets": report}, "\n".join(texts), t.stages, starts,
         tuple(continuum_record(c, n) for n, c in enumerate(continua, start=1)),
     )  # fmt: skip
+
+
+def check_route(model, settings: Settings) -> None:
+    """Refuse a route the model cannot take, before any work or folder (ParameterError)."""
+    if isinstance(model, Params):
+        if settings.route == "real":
+            raise ParameterError(
+                "route = 'real': the paper's mechanism is solved by Bertini (every complex root, "
+                "0.4 s); the same mechanism as a framework, examples/cotm.toml, takes the real "
+                "route"
+            )
+    else:
+        framework_route(model, settings)
 
 
 def framework_route(fw, settings: Settings) -> str:

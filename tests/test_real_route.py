@@ -273,6 +273,24 @@ def test_a_lost_root_is_caught_by_the_morse_count(monkeypatch):
     assert any("Morse" in w for w in res.warnings)
 
 
+def test_route_real_is_refused_for_the_papers_mechanism(tmp_path):
+    """The paper's model is Bertini's (its mission): route='real' is refused, not ignored."""
+    with pytest.raises(cb.ParameterError, match="route = 'real': the paper's mechanism"):
+        cb.solve(cb.Params.case("case3"), route="real")
+    out = subprocess.run(
+        [sys.executable, "-m", "cotm_bertini.cli", "solve", "case3", "--route", "real",
+         "--out", str(tmp_path)],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert out.returncode == 2 and "route = 'real'" in out.stderr and not list(tmp_path.iterdir())
+    with pytest.raises(cb.ParameterError, match="route = 'real'"):  # before any folder
+        cb.sweep(cb.Params(), "L01", [0.0, 1.0], route="real", out=tmp_path)
+    fourbar = cb.Framework.from_toml(ROOT / "examples" / "fourbar.toml")
+    with pytest.raises(cb.ParameterError, match="route = 'real'.*closed loop"):
+        cb.sweep(fourbar, "L0", [0.4, 0.5], route="real", out=tmp_path)
+    assert not list(tmp_path.iterdir())
+
+
 def test_route_real_is_refused_where_it_does_not_cover_the_space():
     fw = cb.Framework.from_toml(ROOT / "examples" / "fourbar.toml")
     with pytest.raises(cb.ParameterError, match="route = 'real'.*closed loop"):

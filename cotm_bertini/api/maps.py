@@ -105,6 +105,7 @@ def design_map(
     points=101) (or positionally design_map(params, (0, 14), (0, 14), 101))."""
     from ..continuation.runner import check_workers
     from ..continuation.spec import check_grid
+    from ..point import check_route
     from .sweeps import sweep
 
     (x, xr), (y, yr), points = map_axes(model, axes, l01, l02, points)
@@ -114,6 +115,7 @@ def design_map(
     xs, ys = grid_values(*xr, points), grid_values(*yr, points)
     check_grid(model, x, tuple(map(float, xs)), y, tuple(map(float, ys)))  # every point too
     check_workers(workers)  # before any process starts
+    check_route(model, settings or Settings())
     key = _map_key(model, (x, xr), (y, yr), points, settings)
     made = _made_before(model, key, (x, y))
     if made is not None:

@@ -139,9 +139,11 @@ def sweep(
     """
     from ..continuation.runner import check_workers, prepare
     from ..continuation.spec import SweepSpec, check_grid
+    from ..point import check_route
 
     check_workers(workers)  # before any folder is made
     settings = (settings or Settings()).replace(**options)
+    check_route(params, settings)
     framework = None
     if not isinstance(params, Params):  # a cb.Framework: its parameters are swept
         from ..continuation.framework import encode

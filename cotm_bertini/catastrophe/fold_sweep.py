@@ -111,7 +111,7 @@ def _generic_sets(task) -> None:
 
 
 def _solve_line(task) -> dict:
-    """{point: (its real equilibria with positive lengths, lost paths)} along one line, each
+    """{point: (its real equilibria with positive lengths, lost paths, 0)} along one line, each
     continued from the one before when that is proved complete (backends.target)."""
     from ..backends.target import solve_parameters
 
@@ -129,14 +129,14 @@ def _solve_line(task) -> dict:
             raise AssertionError("the fold system's unknowns differ from the equilibria's")
         hs = solve_parameters(fs.ps, normalized_slots(fwp), centre, settings,
                               variable_groups(fs), warm)  # fmt: skip
-        out[mx, my], warm = (real_points(hs), int(hs.info["lost"])), hs.warm
+        out[mx, my], warm = (real_points(hs), int(hs.info["lost"]), 0), hs.warm
     return out
 
 
 def _real_line(task) -> dict:
     """`_solve_line` by the real route: each crossing's real equilibria of the taut set (those
     consistent with its cable states: a branch that becomes consistent between two crossings
-    enters through a cable switch), and as 'lost' the boxes its search left undecided."""
+    enters through a cable switch), no path lost, and the boxes its search left undecided."""
     from ..backends.real_route import real_equilibria
 
     fw, cs, spec, ts, names, _ = task
@@ -149,21 +149,23 @@ def _real_line(task) -> dict:
         if eps is not None and tuple(eps.variables) != cs.variables:
             raise AssertionError("the fold system's unknowns differ from the equilibria's")
         pts = eps.points.real if eps is not None else np.zeros((0, len(cs.variables)))
-        out[mx, my] = (pts, len(found.undecided))
+        out[mx, my] = (pts, 0, len(found.undecided))
     return out
 
 
 def _line_folds(task) -> tuple[list[np.ndarray], dict]:
     """One line's fold points (its branches' turns) and its record."""
     cs, spec, ts, solved = task
-    branches = _branches(cs, spec, ts, [pts for pts, _ in solved])
+    branches = _branches(cs, spec, ts, [pts for pts, *_ in solved])
     found, counts = _turning_folds(cs, spec, branches)
     record = {
         "line": [float(v) for v in spec], "points": len(ts), "branches": len(branches),
         "stalled_ends": sum(e in ("stalled", "max_points") for b in branches for e in b.ends),
         "real_in_window": len(found), **counts,
-        # Each crossing's solve is counted once, on its vertical line (sweep_seeds solves it).
-        "lost": sum(lost for _, lost in solved) if spec[2] == 0.0 else 0,
+        # Each crossing's solve is counted once, on its vertical line (sweep_seeds solves it):
+        # paths lost (complex route) and boxes its search left undecided (real route).
+        "lost": sum(s[1] for s in solved) if spec[2] == 0.0 else 0,
+        "undecided_boxes": sum(s[2] for s in solved) if spec[2] == 0.0 else 0,
     }  # fmt: skip
     return found, record
 

@@ -279,6 +279,7 @@ def _find(fw: Framework, cs: CurveSystem, axes, settings, seeds: str, work: _Wor
         "seeds": len(seeds_found), "seeds_on_traced": skipped, "lines": lines,
         "ends": [list(c.ends) for c in traced],
         "lost_paths": int(sum(ln.get("lost", 0) for ln in lines)),
+        "undecided_boxes": int(sum(ln.get("undecided_boxes", 0) for ln in lines)),
         "unrefined_turns": int(sum(ln.get("unrefined", 0) for ln in lines)),
     })  # fmt: skip
     return _Curves(cs, traced, win, eqs), info

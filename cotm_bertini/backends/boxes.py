@@ -58,6 +58,9 @@ class BoxLandscape(Protocol):
     def derivatives(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """grad V and its Hessian at points (R, n) in double precision."""
 
+    # Optional: `domain(start) -> (lo, hi)`, the boxes that cover the configuration space
+    # (charts of a sphere, say); without it the torus grid of `initial_boxes`.
+
 
 @dataclass
 class BoxSearch:
@@ -76,15 +79,16 @@ class BoxSearch:
     shortest_length: float  # every spring with a free length is at least this long elsewhere
     budget_hit: str = ""
     notes: list[str] = field(default_factory=list)
+    volume: float = 0.0  # of the domain searched (0: the torus, (2 pi)^n)
 
     @property
     def undecided_share(self) -> float:
-        """The share of the torus's volume in undecided boxes."""
+        """The share of the domain's volume in undecided boxes."""
         if not len(self.undecided):
             return 0.0
         n = self.undecided.shape[1] // 2
         w = self.undecided[:, n:] - self.undecided[:, :n]
-        return float(np.prod(w / TWO_PI, axis=1).sum())
+        return float(np.prod(w, axis=1).sum() / (self.volume or TWO_PI**n))
 
 
 def initial_boxes(n: int, start: int) -> tuple[np.ndarray, np.ndarray]:
@@ -92,6 +96,12 @@ def initial_boxes(n: int, start: int) -> tuple[np.ndarray, np.ndarray]:
     edges = OFFSET + TWO_PI * np.arange(start + 1) / start
     idx = np.indices((start,) * n).reshape(n, -1).T
     return edges[idx], edges[idx + 1]
+
+
+def domain(land: BoxLandscape, start: int) -> tuple[np.ndarray, np.ndarray]:
+    """The boxes a search starts from: the landscape's own cover, or the torus grid."""
+    cover = getattr(land, "domain", None)
+    return cover(start) if cover is not None else initial_boxes(land.n, start)
 
 
 def search(
@@ -102,12 +112,16 @@ def search(
     max_boxes: int | None = None,
     max_seconds: float | None = None,
     label: str = "real search",
+    boxes: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> BoxSearch:
-    """Decide every box of the torus (module docstring); stop at `max_boxes` or `max_seconds`
-    with the boxes not yet decided listed as undecided."""
+    """Decide every box of the domain (module docstring), or of `boxes` (lo, hi) where given
+    (a share of it, for a worker); stop at `max_boxes` or `max_seconds` with the boxes not yet
+    decided listed as undecided."""
     t0 = time.perf_counter()
     n = land.n
-    stack = [initial_boxes(n, start)]
+    first = boxes if boxes is not None else domain(land, start)
+    volume = float(np.prod(first[1] - first[0], axis=1).sum())
+    stack = [first]
     roots, root_boxes, undecided = [], [], []
     acc = {"boxes": 0, "aside": 0, "bound": 0.0, "shortest": math.inf, "failed": 0,
            "aside_boxes": []}  # fmt: skip
@@ -115,7 +129,7 @@ def search(
     report = Progress(label, 1.0, "of the poses decided")
     while stack:
         lo, hi = _take(stack, BATCH)
-        share = float(np.prod((hi - lo) / TWO_PI, axis=1).sum())
+        share = float(np.prod(hi - lo, axis=1).sum()) / volume
         if (max_boxes and acc["boxes"] >= max_boxes) or (
             max_seconds and time.perf_counter() - t0 > max_seconds
         ):
@@ -132,7 +146,7 @@ def search(
             undecided.append(left)
         if len(split[0]):
             stack.append(split)
-            share -= float(np.prod((split[1] - split[0]) / TWO_PI, axis=1).sum())
+            share -= float(np.prod(split[1] - split[0], axis=1).sum()) / volume
         pending -= share
         report.set(1.0 - pending, note=f"{acc['boxes']:,} boxes")
     report.close()
@@ -140,7 +154,7 @@ def search(
     return BoxSearch(
         np.array(roots).reshape(-1, n), np.array(root_boxes).reshape(-1, 2 * n), acc["failed"],
         acc["aside"], acc["bound"], _rows(acc["aside_boxes"], n), undec, acc["boxes"],
-        time.perf_counter() - t0, acc["shortest"], budget,
+        time.perf_counter() - t0, acc["shortest"], budget, volume=volume,
     )  # fmt: skip
 
 

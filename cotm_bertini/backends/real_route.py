@@ -18,7 +18,6 @@ analysis.framework_classify as the complex route's endpoints are.
 from __future__ import annotations
 
 import itertools
-from dataclasses import dataclass
 from functools import cached_property, lru_cache
 
 import numpy as np
@@ -32,8 +31,7 @@ from ..model.framework.units import normalized_slots
 from ..model.intervals import Interval, stack
 from .boxes import MIN_WIDTH, SHORT, BoxSearch, search
 from .endpoints import Endpoints
-
-TAUT, SLACK, EITHER = 1, 0, 2
+from .links import EITHER, SLACK, TAUT, columns, force_density, interval_sum, links
 
 
 def covers(fw: Framework) -> str:
@@ -44,16 +42,6 @@ def covers(fw: Framework) -> str:
     if not lay.is_torus:
         return "a closed loop, a free body or a free node (not a circle or torus of angles)"
     return ""
-
-
-@dataclass(frozen=True, eq=False)
-class Link:
-    """A spring or cable as the landscape sees it (normalised units)."""
-
-    name: str
-    k: float
-    L0: float | None  # None: zero free length (w = k, smooth everywhere)
-    cable: bool
 
 
 class TorusFramework:
@@ -70,11 +58,7 @@ class TorusFramework:
         self.full = framework_system(fw, self.cables)
         self.n = self.full.local_size
         self.bodies = layout(fw).rotations
-        zfl = set(fw.zero_free_length())
-        self.links = tuple(
-            Link(x, slots[f"k_{x}"], None if x in zfl else slots[f"L0_{x}"], x in self.cables)
-            for x in self.full.active
-        )
+        self.links = links(fw, self.full.active)
         self.free_springs = [i for i, x in enumerate(self.links) if x.L0 is not None
                              and not x.cable]  # fmt: skip
 
@@ -111,8 +95,10 @@ class TorusFramework:
         per, dds, slopes = dim + dim * m, [], []
         for i in range(len(self.links)):
             r, dr = first[i * per : i * per + dim], first[i * per + dim : (i + 1) * per]
-            dds.append(_sum(Interval.of(c) * c for c in r))
-            slopes.append([_sum(r[c] * dr[c * m + j] for c in range(dim)) for j in range(m)])
+            dds.append(interval_sum(Interval.of(c) * c for c in r))
+            slopes.append(
+                [interval_sum(r[c] * dr[c * m + j] for c in range(dim)) for j in range(m)]
+            )
         return dds, slopes, first[len(self.links) * per :]
 
     def enclose(self, box: Interval) -> tuple[Interval, Interval, dict]:
@@ -122,29 +108,13 @@ class TorusFramework:
         grad = [Interval.of(np.broadcast_to(0.0, shape)) + g for g in loads]
         states = {}
         for x, dd, a in zip(self.links, dds, slopes, strict=True):
-            w, state = self.force_density(x, dd)
+            w, state = force_density(x, dd)
             if x.cable:
                 states[x.name] = state
             grad = [g + w * aj for g, aj in zip(grad, a, strict=True)]
         lengths = stack([dds[i] for i in self.free_springs], axis=1) if self.free_springs else (
             Interval(np.zeros(shape + (0,))))  # fmt: skip
         return lengths, stack(grad, axis=1), states
-
-    def force_density(self, x: Link, dd: Interval) -> tuple[Interval, np.ndarray]:
-        """w over each box, and a cable's state there (TAUT, SLACK or EITHER)."""
-        shape = dd.lo.shape
-        if x.L0 is None:
-            return Interval(np.full(shape, x.k)), np.full(shape, TAUT)
-        w = x.k * (1.0 - x.L0 / dd.sqrt())
-        if not x.cable:
-            return w, np.full(shape, TAUT)
-        l2 = x.L0 * x.L0
-        state = np.where(dd.lo > l2, TAUT, np.where(dd.hi < l2, SLACK, EITHER))
-        hull_lo = np.where(np.isfinite(w.lo), np.minimum(w.lo, 0.0), 0.0)
-        hull_hi = np.where(np.isfinite(w.hi), np.maximum(w.hi, 0.0), x.k)
-        lo = np.where(state == TAUT, w.lo, np.where(state == SLACK, 0.0, hull_lo))
-        hi = np.where(state == TAUT, w.hi, np.where(state == SLACK, 0.0, hull_hi))
-        return Interval(lo, hi), state
 
     def hessian(self, box: Interval, states: dict) -> Interval:
         """The hull of the Hessians of every taut set each box allows (B, n, n)."""
@@ -173,10 +143,10 @@ class TorusFramework:
         first = self.full.numeric.first_order(self._numeric_pose(self.full, x), P)
         dim, m, per = self.fw.dim, self.n, self.fw.dim + self.fw.dim * self.n
         grad = np.zeros((len(x), m))
-        grad += _columns(first[len(self.links) * per :], len(x)) if m else 0.0
+        grad += columns(first[len(self.links) * per :], len(x)) if m else 0.0
         taut = np.ones((len(x), len(self.cables)), dtype=bool)
         for i, link in enumerate(self.links):
-            block = _columns(first[i * per : (i + 1) * per], len(x))
+            block = columns(first[i * per : (i + 1) * per], len(x))
             r, dr = block[:, :dim], block[:, dim:]
             d = np.sqrt((r * r).sum(axis=1))
             a = np.einsum("nc,ncj->nj", r, dr.reshape(len(x), dim, m))
@@ -192,7 +162,7 @@ class TorusFramework:
             rows = np.flatnonzero((taut == want).all(axis=1))
             if len(rows):
                 h = fs.numeric.hessian(self._numeric_pose(fs, x[rows]), P)
-                hess[rows] = _columns(h, len(rows)).reshape(-1, m, m)
+                hess[rows] = columns(h, len(rows)).reshape(-1, m, m)
         return grad, hess
 
     def _numeric_pose(self, fs: FrameworkSystem, x: np.ndarray) -> np.ndarray:
@@ -294,14 +264,6 @@ def real_equilibria(fw: Framework) -> tuple[dict[tuple[str, ...], Endpoints], Bo
     return {tuple(sorted(k)): v for k, v in land.endpoints(found.roots).items()}, found
 
 
-def _columns(values: list, count: int) -> np.ndarray:
-    """Generated code's outputs (arrays of `count`, or constants) as the columns of one array."""
-    out = np.empty((count, len(values)))
-    for k, v in enumerate(values):
-        out[:, k] = v
-    return out
-
-
 def coarse_pick(boxes: np.ndarray, most: int, cell: float = 0.02) -> np.ndarray:
     """At most `most` of the boxes (lo_1..lo_n, hi_1..hi_n), one a cell of `cell` rad of their
     middles, spread over the list: every cluster of boxes (one around each cone point or along
@@ -312,10 +274,3 @@ def coarse_pick(boxes: np.ndarray, most: int, cell: float = 0.02) -> np.ndarray:
     first = np.sort(first)
     return boxes[first[np.unique(np.linspace(0, len(first) - 1, min(most, len(first)))
                                  .astype(int))]]  # fmt: skip
-
-
-def _sum(items) -> Interval:
-    out = None
-    for v in items:
-        out = Interval.of(v) if out is None else out + v
-    return out

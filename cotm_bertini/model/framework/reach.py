@@ -70,3 +70,29 @@ def cable_states(fw: Framework) -> dict[str, str]:
         taut = lo > L0 or L0 == 0
         out[cable.name] = "taut" if taut else ("slack" if hi < L0 else "either")
     return out
+
+
+def sphere_chain(fw: Framework) -> tuple[tuple[tuple[str, str, str], ...], str]:
+    """((node, the point its bar hangs from, the bar), ...) in hanging order, when every free
+    node of a spatial framework hangs by one bar from a ground point or from a node hung
+    before it (each on a sphere about that point: a product of spheres), else ((), why not)."""
+    lay = layout(fw)
+    if fw.dim != 3 or fw.bodies or fw.pins:
+        return (), "a spatial framework with bodies or pins (spheres of nodes on bars only)"
+    if not lay.free_nodes:
+        return (), "no free node"
+    hung: dict[str, tuple[str, str]] = {}
+    changed = True
+    while changed:
+        changed = False
+        for bar in fw.bars:
+            for top, node in ((bar.a, bar.b), (bar.b, bar.a)):
+                held = owner(top) == "ground" or top in hung
+                if held and node in lay.free_nodes and node not in hung:
+                    hung[node], changed = (top, bar.name), True
+    if len(hung) < len(lay.free_nodes):
+        loose = [n for n in lay.free_nodes if n not in hung]
+        return (), f"node {loose[0]} hangs by no bar from the ground (not a product of spheres)"
+    if len(fw.bars) > len(hung):
+        return (), "a bar closes a loop (not a product of spheres)"
+    return tuple((n, top, bar) for n, (top, bar) in hung.items()), ""

@@ -300,14 +300,14 @@ def _solve_real(fw, settings: Settings, tolerances: Tolerances, t: Timings) -> P
     from .analysis.framework_checks import completeness, framework_counts, order_rows
     from .analysis.framework_continua import absorb, continuum_record, find_continua
     from .backends.boxes import SHORT, search
-    from .backends.real_route import TorusFramework, critical_seeds, fresh_points
+    from .backends.real_route import critical_seeds, landscape
     from .model.framework.compiled import check_terms
     from .model.framework.units import normalized_slots, units
 
     unit = units(fw)
     sets, pruned = split_taut_sets(fw)
     with t.stage("derive"):
-        land = TorusFramework(fw)
+        land = landscape(fw)
         target = normalized_slots(fw)
         for taut, fs in land.hessian_sets:  # derived (or loaded) here, not in the search's clock
             if taut in sets:
@@ -318,9 +318,9 @@ def _solve_real(fw, settings: Settings, tolerances: Tolerances, t: Timings) -> P
         # Critical points the search could not prove: in boxes left undecided (a continuum
         # passes there) or set aside next to a cone point (a saddle leaves the cone point as
         # the other elements' pull there passes k L0): found by Newton, not proved unique.
-        seeds = fresh_points(np.vstack([critical_seeds(land, found.undecided),
-                                        critical_seeds(land, found.set_aside_boxes)]),
-                             found.roots)  # fmt: skip
+        seeds = land.fresh(np.vstack([critical_seeds(land, found.undecided),
+                                      critical_seeds(land, found.set_aside_boxes)]),
+                           found.roots)  # fmt: skip
         groups = land.endpoints(np.vstack([found.roots, seeds]))
     report: dict = {" ".join(taut) or "none": {"excluded": True, "pruned": "bound smoothing",
                     "note": why.note()} for taut, why in pruned.items()}  # fmt: skip

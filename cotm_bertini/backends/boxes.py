@@ -11,7 +11,8 @@ is not smooth at length 0. Each box is
 - decided by the Krawczyk operator K(X) = m - Y g(m) + (I - Y H(X)) (X - m), Y the inverse of
   the Hessian's midpoint: K(X) inside the interior of X proves exactly one critical point in X
   (it lies in K(X)), K(X) disjoint from X proves none;
-- or split along its wide sides; a box that reaches the smallest width undecided is listed.
+- or split along its (at most two) widest sides; a box that reaches the smallest width
+  undecided is listed.
 
 A box with one critical point gives a root: Newton in double precision from the middle of
 K(X) n X. Boxes are rows of two (B, n) arrays, lo and hi, in radians (a box listed in a result
@@ -41,6 +42,7 @@ MIN_WIDTH = 1e-4  # radians: the smallest box away from a critical point
 NEAR_CONE = 10.0  # undecided where a spring may be shorter than this times SHORT: set aside
 NEAR_CONDITION = 1e10  # a critical point worth splitting below MIN_WIDTH for is no worse than this
 ROOT_FLOOR = 1e-10  # radians: boxes are not split below this, whatever a spring's length
+MAX_CUTS = 2  # sides halved at a split (see _split)
 
 
 class BoxLandscape(Protocol):
@@ -266,11 +268,17 @@ def _floor(dd: Interval, min_width: float) -> np.ndarray:
 
 
 def _split(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Each box halved along every side at least half as wide as its widest."""
+    """Each box halved along its MAX_CUTS widest sides (those at least half as wide as its
+    widest): in six or eight dimensions a box cut along every side makes 64 or 256 boxes
+    where the first halvings would often have excluded half of them (prism_slack: 15.8 million
+    boxes -> 2.6 million)."""
     if not len(lo):
         return lo, hi
     w = hi - lo
-    cut = w >= 0.5 * w.max(axis=1, keepdims=True)
+    widest = np.argsort(-w, axis=1, kind="stable")[:, :MAX_CUTS]
+    cut = np.zeros(w.shape, dtype=bool)
+    np.put_along_axis(cut, widest, True, axis=1)
+    cut &= w >= 0.5 * w.max(axis=1, keepdims=True)
     for j in range(lo.shape[1]):
         c = cut[:, j]
         mid = 0.5 * (lo[c, j] + hi[c, j])

@@ -24,7 +24,7 @@ import numpy as np
 
 from ..model.framework.ballcode import ball_module
 from ..model.framework.compiled import FrameworkSystem, framework_system, slot_vector
-from ..model.framework.reach import cable_states
+from ..model.framework.reach import cable_states, sphere_chain
 from ..model.framework.spec import Framework
 from ..model.framework.structure import layout
 from ..model.framework.units import normalized_slots
@@ -32,16 +32,22 @@ from ..model.intervals import Interval, stack
 from .boxes import MIN_WIDTH, SHORT, BoxSearch, search
 from .endpoints import Endpoints
 from .links import EITHER, SLACK, TAUT, columns, force_density, interval_sum, links
+from .spheres import SphereFramework
 
 
 def covers(fw: Framework) -> str:
-    """'' where the real route covers the framework's configuration space, else why not."""
-    lay = layout(fw)
-    if fw.dim != 2:
-        return "a spatial framework (the real route covers circles and tori of planar bodies)"
-    if not lay.is_torus:
+    """'' where the real route covers the framework's configuration space (a circle or torus
+    of planar bodies' angles, or a product of spheres of nodes hung on bars), else why not."""
+    if fw.dim == 3:
+        return sphere_chain(fw)[1]
+    if not layout(fw).is_torus:
         return "a closed loop, a free body or a free node (not a circle or torus of angles)"
     return ""
+
+
+def landscape(fw: Framework) -> TorusFramework | SphereFramework:
+    """V over boxes of the framework's configuration space (covers says which)."""
+    return SphereFramework(fw) if fw.dim == 3 else TorusFramework(fw)
 
 
 class TorusFramework:
@@ -172,6 +178,10 @@ class TorusFramework:
             X[:, index[f"s_{b}"]], X[:, index[f"c_{b}"]] = np.sin(x[:, j]), np.cos(x[:, j])
         return X
 
+    def fresh(self, points: np.ndarray, known: np.ndarray) -> np.ndarray:
+        """The points that are neither at a `known` one nor at an earlier one (fresh_points)."""
+        return fresh_points(points, known)
+
     def endpoints(self, roots: np.ndarray) -> dict[tuple[str, ...], Endpoints]:
         """The critical points (R, n angles) as endpoints of their taut sets' systems."""
         d = self._lengths(roots)
@@ -259,7 +269,7 @@ def real_equilibria(fw: Framework) -> tuple[dict[tuple[str, ...], Endpoints], Bo
     """Every real critical point of V (the search's default settings), as endpoints by taut set
     (keys sorted, as FrameworkSystem.taut), with the search's record; kept for the last
     frameworks asked for, since fold seeds of every curve system share their crossings."""
-    land = TorusFramework(fw)
+    land = landscape(fw)
     found = search(land, SHORT, MIN_WIDTH, label=f"real search of {fw.name}")
     return {tuple(sorted(k)): v for k, v in land.endpoints(found.roots).items()}, found
 

@@ -3,9 +3,9 @@
 An `Interval` holds arrays `lo` and `hi` (any broadcastable shapes) with lo <= x <= hi for every
 real number x it stands for. Each operation computes its bounds in double precision and moves
 them outwards: IEEE addition, multiplication, division and square root are correctly rounded
-(error at most half an ulp), so one `nextafter` step each way keeps the true result inside;
-sin, cos and non-integer powers (whose libm results are not guaranteed correctly rounded) are
-widened further (`_PAD_TRIG`, `_PAD_POW`). An unbounded or undefined result is [-inf, inf].
+(error at most half an ulp), so a step of |x| 2^-52 (at least one ulp) each way keeps the true
+result inside; sin, cos and non-integer powers (whose libm results are not guaranteed correctly
+rounded) are widened further (`_PAD_TRIG`, `_PAD_POW`). An unbounded or undefined result is [-inf, inf].
 
 It has the methods a framework's generated code calls (+ - * / **, sqrt, sin, cos: the same
 source `model.framework.ballcode` evaluates on arb balls), so one call of a generated function
@@ -21,12 +21,25 @@ _PAD_TRIG = 4e-16  # absolute: libm sin/cos are within one ulp (<= 1.2e-16 on [-
 _PAD_POW = 8e-16  # relative: libm pow is within a few ulps
 
 
+_EPS = 2.0**-52  # |x| * _EPS is at least the gap from x to the next double either side
+_TINY = 1e-300  # absolute: covers results that underflow (their error is below 1e-323)
+_MAX = np.finfo(float).max
+
+
 def _down(x: np.ndarray) -> np.ndarray:
-    return np.nextafter(x, -INF)
+    """A double below every real number that rounds to x: x - |x| eps lies at or beyond the
+    next double below, and rounding is monotone (several times cheaper than nextafter); an
+    overflow to +inf moves back to the largest double (a lower bound is never +inf)."""
+    with np.errstate(invalid="ignore", over="ignore"):
+        out = x - (np.abs(x) * _EPS + _TINY)
+    return np.where(x == INF, _MAX, out)
 
 
 def _up(x: np.ndarray) -> np.ndarray:
-    return np.nextafter(x, INF)
+    """A double above every real number that rounds to x (see _down)."""
+    with np.errstate(invalid="ignore", over="ignore"):
+        out = x + (np.abs(x) * _EPS + _TINY)
+    return np.where(x == -INF, -_MAX, out)
 
 
 def _clean(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

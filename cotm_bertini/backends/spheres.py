@@ -1,0 +1,393 @@
+"""The real route on spheres: a spatial framework whose free nodes each hang by a bar from a
+ground point or from a node hung before it (model.framework.reach.sphere_chain), so that its
+poses form a product of 2-spheres, searched by backends.boxes over charts of each sphere.
+
+Charts. A node's direction u from the point it hangs from is given by two angles (a, b) in one of
+two charts: A, u = (sin a cos b, sin a sin b, cos a), over a band of a that leaves out the poles
+on the z axis; and B, u = (cos a, sin a cos b, sin a sin b), the same with the axes turned (poles
+on the x axis), over two squares around +z (a = b = pi/2) and -z (a = pi/2, b = -pi/2) that hold
+the caps the band leaves out, with a margin: a direction within angle t of +z has
+|a - pi/2| = asin|u_x| <= t and |b - pi/2| = atan(|u_y| / u_z) <= t. Every box lies in one chart;
+chart B's a is stored shifted by SHIFT so that a box says its chart. Both charts are regular
+(sin a >= sin BAND), so a critical point of V in chart angles is one on the spheres; one in an
+overlap of charts is found in both and kept once. The charts' edges are no simple fractions of
+pi (a symmetric pose on the edge of a box is never proved alone in it).
+
+V in chart angles: node positions X = parent + length u; grad V = J^T g, g the gradient in node
+coordinates from the generated first_order of the structure with every cable taut (each cable's
+force density enclosed as the torus route does, links.force_density); the Hessian is
+J^T H J + sum_i g_i d2X_i, H the generated Hessian with each cable's stiffness the interval [0, k]
+where the cable may be taut or slack over the box: H is linear in k, so that encloses the
+Hessian of every taut set the box allows (the hull the torus route forms set by set).
+"""
+
+from __future__ import annotations
+
+import math
+from functools import cached_property
+
+import numpy as np
+
+from ..model.framework.ballcode import ball_module
+from ..model.framework.compiled import FrameworkSystem, framework_system, slot_vector
+from ..model.framework.reach import sphere_chain
+from ..model.framework.spec import Framework, owner
+from ..model.framework.units import normalized_slots
+from ..model.intervals import Interval, stack
+from .boxes import OFFSET
+from .endpoints import Endpoints
+from .links import SLACK, TAUT, columns, force_density, interval_sum, links
+
+SHIFT = 8.0  # chart B's first angle is stored as a + SHIFT
+BAND = 0.6107  # chart A covers a in [BAND + TILT, pi - BAND + TILT]
+TILT = 0.0071  # moves the band's middle (pi/2) off the halving lines
+CAP = BAND + 0.0731  # chart B's squares: half side (more than BAND + TILT + SKEW: overlap)
+SKEW = 0.0173  # moves the squares' middles (+-z) off the halving lines
+SECOND = (((0, 0), "uaa"), ((0, 1), "uab"), ((1, 0), "uab"), ((1, 1), "ubb"))
+APART = 1e-8  # normalised length units: two critical points closer than this are one
+
+
+def pieces() -> list[tuple[tuple[float, float], tuple[float, float]]]:
+    """The chart boxes ((a lo, a hi), (b lo, b hi)) that cover one sphere: the band of chart A
+    and chart B's two squares around the poles +z and -z."""
+    band = ((BAND + TILT, math.pi - BAND + TILT), (OFFSET, OFFSET + 2 * math.pi))
+    a = (SHIFT + math.pi / 2 - CAP + SKEW, SHIFT + math.pi / 2 + CAP + SKEW)
+    squares = [(a, (s * math.pi / 2 - CAP + SKEW, s * math.pi / 2 + CAP + SKEW)) for s in (1, -1)]
+    return [band, *squares]
+
+
+def _trig(a):
+    return a.sin_cos() if isinstance(a, Interval) else (np.sin(a), np.cos(a))
+
+
+def _pick(mask: np.ndarray, a, b):
+    if isinstance(a, Interval) or isinstance(b, Interval):
+        return Interval.where(mask, a, b)
+    return np.where(mask, a, b)
+
+
+def directions(a, b) -> dict[str, list]:
+    """u and its derivatives in the chart angles (u_a, u_b, u_aa, u_ab, u_bb), each three
+    components (Intervals or arrays), for angles (a, b) of either chart (module docstring)."""
+    lo = a.lo if isinstance(a, Interval) else a
+    turned = lo >= SHIFT / 2
+    (sa, ca), (sb, cb) = _trig(a - SHIFT * turned), _trig(b)
+    zero = 0.0 * cb
+    out = {
+        "u": [sa * cb, sa * sb, ca],
+        "ua": [ca * cb, ca * sb, -sa],
+        "ub": [-(sa * sb), sa * cb, zero],
+        "uaa": [-(sa * cb), -(sa * sb), -ca],
+        "uab": [-(ca * sb), ca * cb, zero],
+        "ubb": [-(sa * cb), -(sa * sb), zero],
+    }
+    # Chart B is chart A with the axes turned: its (x, y, z) is A's (z, x, y).
+    return {k: [_pick(turned, v[p], v[c]) for c, p in enumerate((2, 0, 1))]
+            for k, v in out.items()}  # fmt: skip
+
+
+class SphereFramework:
+    """V of a spatial framework whose nodes hang from the ground by bars, over chart boxes."""
+
+    def __init__(self, fw: Framework):
+        chain, why = sphere_chain(fw)
+        if why:
+            raise ValueError(f"the real route does not cover {fw.name}: {why}")
+        self.fw = fw
+        self.slots = normalized_slots(fw)
+        self.P = [float(v) for v in slot_vector(self.slots)]
+        self.cables = tuple(c.name for c in fw.cables)
+        self.full = framework_system(fw, self.cables)
+        self.links = links(fw, self.full.active)
+        self.nodes = tuple(n for n, _, _ in chain)
+        self.parent = {n: top for n, top, _ in chain}
+        self.length = {n: self.slots[f"len_{bar}"] for n, _, bar in chain}
+        self.n = 2 * len(self.nodes)
+        self.bodies = ()  # no body angles (point.along_continua)
+        names = list(self.full.ps.variables)
+        self.coords = [names.index(f"n_{v}_{c}") for v in self.nodes for c in "xyz"]
+        # The generated code's local coordinates are the nodes' coordinates, in this order.
+        if self.coords != list(range(self.full.local_size)):
+            raise ValueError(f"{fw.name}: node coordinates are not the local coordinates")
+        self.k_slots = {c: list(self.slots).index(f"k_{c}") for c in self.cables}
+
+    @cached_property
+    def hessian_sets(self) -> list[tuple[tuple[str, ...], FrameworkSystem]]:
+        """The systems whose generated code the search evaluates (every cable taut)."""
+        return [(self.cables, self.full)]
+
+    def domain(self, start: int) -> tuple[np.ndarray, np.ndarray]:
+        """The product of each node's chart boxes: 3^nodes boxes (lo, hi), each (count, n)."""
+        parts = pieces()
+        idx = np.indices((len(parts),) * len(self.nodes)).reshape(len(self.nodes), -1).T
+        lo = np.array([[v for i in row for v in (parts[i][0][0], parts[i][1][0])] for row in idx])
+        hi = np.array([[v for i in row for v in (parts[i][0][1], parts[i][1][1])] for row in idx])
+        return lo, hi
+
+    def subtree(self, node: str) -> list[int]:
+        """Indices of the nodes that hang from `node` (itself included)."""
+        out = []
+        for i, v in enumerate(self.nodes):
+            while v != node and v in self.parent:
+                v = self.parent[v]
+            if v == node:
+                out.append(i)
+        return out
+
+    def pull(self, g: list, node: str) -> list:
+        """The force on `node`'s bar end: the gradient (in node coordinates) of every node
+        hanging from it, summed (three components)."""
+        return [_total([g[3 * j + c] for j in self.subtree(node)]) for c in range(3)]
+
+    def kinematics(self, x) -> tuple[list, list]:
+        """(positions: three per node, directions per node) at boxes (Interval) or points."""
+        dirs, pos = [], {}
+        for i, v in enumerate(self.nodes):
+            d = directions(x[:, 2 * i], x[:, 2 * i + 1])
+            top = self.parent[v]
+            if owner(top) == "ground":
+                g = top.split(".", 1)[1]
+                base = [self.slots[f"g_{g}_{c}"] for c in "xyz"]
+            else:
+                base = pos[top]
+            pos[v] = [b + self.length[v] * u for b, u in zip(base, d["u"], strict=True)]
+            dirs.append(d)
+        return [c for v in self.nodes for c in pos[v]], dirs
+
+    def pose(self, positions: list, count: int) -> list:
+        """The generated code's arguments: the node coordinates, the rest 0 (read by nothing)."""
+        X: list = [0.0] * len(self.full.ps.variables)
+        for j, p in zip(self.coords, positions, strict=True):
+            X[j] = p
+        return X
+
+    def node_gradient(self, positions: list, count: int):
+        """(g in node coordinates, squared lengths per link, cable states) over boxes."""
+        first = ball_module(self.full).first_order(self.pose(positions, count), self.P)
+        m, per = len(positions), 3 + 3 * len(positions)
+        g = [Interval(np.zeros(count)) + v for v in first[len(self.links) * per :]]
+        dds, states = [], {}
+        for i, x in enumerate(self.links):
+            r, dr = first[i * per : i * per + 3], first[i * per + 3 : (i + 1) * per]
+            dd = interval_sum(Interval.of(c) * c for c in r)
+            w, state = force_density(x, dd)
+            if x.cable:
+                states[x.name] = state
+            for j in range(m):
+                terms = [r[c] * dr[c * m + j] for c in range(3) if not _zero(dr[c * m + j])]
+                if terms:
+                    g[j] = g[j] + w * interval_sum(terms)
+            dds.append(dd)
+        return g, dds, states
+
+    def enclose(self, box: Interval) -> tuple[Interval, Interval, dict]:
+        """(squared lengths of the free-length springs, grad V in chart angles, cable states)."""
+        count = box.lo.shape[0]
+        positions, dirs = self.kinematics(box)
+        g, dds, states = self.node_gradient(positions, count)
+        grad = []
+        for i, v in enumerate(self.nodes):
+            G = self.pull(g, v)
+            grad += [self.length[v] * _dot(dirs[i][key], G) for key in ("ua", "ub")]
+        springs = [dd for x, dd in zip(self.links, dds, strict=True) if x.L0 is not None
+                   and not x.cable]  # fmt: skip
+        lengths = stack(springs, axis=1) if springs else Interval(np.zeros((count, 0)))
+        return lengths, stack(grad, axis=1), states
+
+    def jacobian(self, dirs: list, count: int) -> list:
+        """dX/d(angles) as rows (3 per node) of columns (2 per node): Intervals or arrays."""
+        zero = np.zeros(count)
+        J = [[zero] * self.n for _ in range(3 * len(self.nodes))]
+        for i, v in enumerate(self.nodes):
+            for j in self.subtree(v):
+                for c in range(3):
+                    J[3 * j + c][2 * i] = self.length[v] * dirs[i]["ua"][c]
+                    J[3 * j + c][2 * i + 1] = self.length[v] * dirs[i]["ub"][c]
+        return J
+
+    def hessian(self, box: Interval, states: dict) -> Interval:
+        """A slope matrix of grad V over each box (B, n, n) (module docstring)."""
+        count = box.lo.shape[0]
+        positions, dirs = self.kinematics(box)
+        g, _, _ = self.node_gradient(positions, count)
+        P = list(self.P)
+        for c, j in self.k_slots.items():
+            s = states.get(c, np.full(count, TAUT))
+            P[j] = Interval(np.where(s == TAUT, P[j], 0.0), np.where(s == SLACK, 0.0, P[j]))
+        h = ball_module(self.full).hessian(self.pose(positions, count), P)
+        m = len(positions)
+        flat = stack([Interval(np.zeros(count)) + v for v in h], axis=1)
+        H = Interval(flat.lo.reshape(count, m, m), flat.hi.reshape(count, m, m))
+        J = stack([stack(row, axis=1) for row in self.jacobian(dirs, count)], axis=1)
+        JT = Interval(np.swapaxes(J.lo, 1, 2), np.swapaxes(J.hi, 1, 2))
+        HJ = (H[:, :, :, None] * J[:, None, :, :]).isum(axis=2)
+        out = (JT[:, :, :, None] * HJ[:, None, :, :]).isum(axis=2)
+        return self._curvature(out, g, dirs, count)
+
+    def _curvature(self, out, g: list, dirs: list, count: int):
+        """Add sum_i g_i d2X_i/d(angles)^2: each node's own 2 x 2 block, length times the
+        gradient of everything hanging from it along u's second derivatives."""
+        lo, hi = out.lo.copy(), out.hi.copy()
+        for i, v in enumerate(self.nodes):
+            G = self.pull(g, v)
+            for (p, q), key in SECOND:
+                t = Interval(np.zeros(count)) + self.length[v] * _dot(dirs[i][key], G)
+                a, b = 2 * i + p, 2 * i + q
+                lo[:, a, b] += t.lo
+                hi[:, a, b] += t.hi
+        # The additions above are rounded to nearest: widen by their error bound.
+        pad = 4 * np.finfo(float).eps * (np.abs(lo) + np.abs(hi)) + 1e-300
+        return Interval(lo - pad, hi + pad)
+
+    def derivatives(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """grad V and its Hessian at points (R, n chart angles) in double precision (each
+        point's Hessian that of its taut set: slack cables' stiffness 0)."""
+        count = len(x)
+        positions, dirs = self.kinematics(x)
+        X = np.zeros((count, len(self.full.ps.variables)))
+        X[:, self.coords] = np.stack(positions, axis=1)
+        P = np.tile(np.asarray(self.P), (count, 1))
+        first = self.full.numeric.first_order(X, P)
+        m, per = len(positions), 3 + 3 * len(positions)
+        g = columns(first[len(self.links) * per :], count)
+        for i, link in enumerate(self.links):
+            block = columns(first[i * per : (i + 1) * per], count)
+            r, dr = block[:, :3], block[:, 3:].reshape(count, 3, m)
+            d = np.sqrt((r * r).sum(axis=1))
+            w = np.full(count, link.k) if link.L0 is None else link.k * (1 - link.L0 / d)
+            if link.cable and link.L0 is not None:
+                P[:, self.k_slots[link.name]] *= d > link.L0
+                w = np.where(d > link.L0, w, 0.0)
+            g += w[:, None] * np.einsum("nc,ncj->nj", r, dr)
+        H = columns(self.full.numeric.hessian(X, P), count).reshape(count, m, m)
+        J = np.stack([np.stack(row, axis=1) for row in self.jacobian(dirs, count)], axis=1)
+        hess = np.einsum("nia,nij,njb->nab", J, H, J)
+        for i, v in enumerate(self.nodes):
+            G = self.pull(list(g.T), v)
+            for (p, q), key in SECOND:
+                hess[:, 2 * i + p, 2 * i + q] += self.length[v] * _dot(dirs[i][key], G)
+        return np.einsum("nia,ni->na", J, g), hess
+
+    def positions(self, x: np.ndarray) -> np.ndarray:
+        """Node coordinates (R, 3 per node) at points (R, n chart angles)."""
+        return np.stack(self.kinematics(x)[0], axis=1)
+
+    def fresh(self, points: np.ndarray, known: np.ndarray) -> np.ndarray:
+        """The points that are neither at the pose of a `known` one nor of an earlier one."""
+        kept: list[np.ndarray] = []
+        seen = list(self.positions(known)) if len(known) else []
+        for x, p in zip(points, self.positions(points) if len(points) else [], strict=True):
+            if all(np.abs(p - q).max() > APART for q in seen):
+                kept.append(x)
+                seen.append(p)
+        return np.array(kept).reshape(-1, self.n)
+
+    def endpoints(self, roots: np.ndarray) -> dict[tuple[str, ...], Endpoints]:
+        """The critical points (chart angles), each pose once, as endpoints of their taut
+        sets' systems (node coordinates, each link's d and w, each bar's multiplier)."""
+        roots = self.fresh(roots, np.zeros((0, self.n)))
+        X = self.positions(roots)
+        d = self._lengths(X)
+        taut = np.ones((len(roots), len(self.cables)), dtype=bool)
+        for j, c in enumerate(self.cables):
+            x = next((y for y in self.links if y.name == c), None)
+            if x is not None and x.L0 is not None:
+                taut[:, j] = d[c] >= x.L0
+        grad, _ = self.derivatives_in_nodes(roots)
+        out = {}
+        for key in {tuple(row) for row in taut}:
+            rows = np.flatnonzero((taut == np.array(key)).all(axis=1))
+            names = tuple(c for c, on in zip(self.cables, key, strict=True) if on)
+            fs = framework_system(self.fw, names)
+            out[names] = self._endpoints(fs, X[rows], {k: v[rows] for k, v in d.items()},
+                                         grad[rows])  # fmt: skip
+        return out
+
+    def derivatives_in_nodes(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """grad V in node coordinates at points (R, n chart angles), and the positions."""
+        count = len(x)
+        positions, _ = self.kinematics(x)
+        X = np.zeros((count, len(self.full.ps.variables)))
+        X[:, self.coords] = np.stack(positions, axis=1)
+        first = self.full.numeric.first_order(X, np.asarray(self.P))
+        m, per = len(positions), 3 + 3 * len(positions)
+        g = columns(first[len(self.links) * per :], count)
+        for i, link in enumerate(self.links):
+            block = columns(first[i * per : (i + 1) * per], count)
+            r, dr = block[:, :3], block[:, 3:].reshape(count, 3, m)
+            d = np.sqrt((r * r).sum(axis=1))
+            w = np.full(count, link.k) if link.L0 is None else link.k * (1 - link.L0 / d)
+            if link.cable and link.L0 is not None:
+                w = np.where(d > link.L0, w, 0.0)
+            g += w[:, None] * np.einsum("nc,ncj->nj", r, dr)
+        return g, X[:, self.coords]
+
+    def _lengths(self, X: np.ndarray) -> dict[str, np.ndarray]:
+        """Each spring's and cable's length at poses X (R, node coordinates)."""
+        full = np.zeros((len(X), len(self.full.ps.variables)))
+        full[:, self.coords] = X
+        first = self.full.numeric.first_order(full, np.asarray(self.P))
+        per = 3 + 3 * len(self.coords)
+        return {x.name: np.sqrt((columns(first[i * per : i * per + 3], len(X)) ** 2).sum(axis=1))
+                for i, x in enumerate(self.links)}  # fmt: skip
+
+    def bar_gradients(self, X: np.ndarray) -> np.ndarray:
+        """(R, bars, node coordinates): the gradient of each bar's (|r|^2 - length^2) / 2."""
+        out = np.zeros((len(X), len(self.nodes), len(self.coords)))
+        for b, v in enumerate(self.nodes):
+            i, top = self.nodes.index(v), self.parent[v]
+            r = X[:, 3 * i : 3 * i + 3] - (
+                np.array([self.slots[f"g_{top.split('.', 1)[1]}_{c}"] for c in "xyz"])
+                if owner(top) == "ground" else X[:, 3 * self.nodes.index(top) :][:, :3]
+            )  # fmt: skip
+            out[:, b, 3 * i : 3 * i + 3] = r
+            if owner(top) != "ground":
+                j = self.nodes.index(top)
+                out[:, b, 3 * j : 3 * j + 3] = -r
+        return out
+
+    def _endpoints(self, fs: FrameworkSystem, X: np.ndarray, d: dict, grad: np.ndarray):
+        """Endpoints of `fs` at poses X: node coordinates, d and w of each link, and each bar's
+        multiplier from grad V + sum mu grad g = 0 (least squares; exact at a critical point)."""
+        A = self.bar_gradients(X)
+        mu = np.stack(
+            [np.linalg.lstsq(a.T, -g, rcond=None)[0] for a, g in zip(A, grad, strict=True)]
+        )
+        links_by = {x.name: x for x in self.links}
+        bars = {bar: self.nodes.index(v) for v, _, bar in sphere_chain(self.fw)[0]}
+        values = np.zeros((len(X), len(fs.ps.variables)), dtype=complex)
+        for k, v in enumerate(fs.ps.variables):
+            head, _, rest = v.partition("_")
+            if head == "n":
+                node, axis = rest.rsplit("_", 1)
+                values[:, k] = X[:, 3 * self.nodes.index(node) + "xyz".index(axis)]
+            elif head == "d":
+                values[:, k] = d[rest]
+            elif head == "w":
+                x = links_by[rest]
+                values[:, k] = x.k * (1.0 - x.L0 / d[rest])
+            elif head == "mu":
+                values[:, k] = mu[:, bars[rest]]
+            else:
+                raise ValueError(f"the real route has no value for unknown {v}")
+        count = len(X)
+        nan = np.full(count, np.nan)
+        return Endpoints(
+            tuple(fs.ps.variables), values, np.arange(count, dtype=np.int64), nan, nan, nan,
+            np.zeros(count), nan, nan, nan, np.ones(count, dtype=np.int64),
+            np.zeros(count, dtype=bool),
+        )  # fmt: skip
+
+
+def _dot(u: list, v: list):
+    """u . v for three components (Intervals or arrays)."""
+    return _total([a * b for a, b in zip(u, v, strict=True)])
+
+
+def _total(items: list):
+    """A sum of Intervals (rounded outwards) or of arrays."""
+    return interval_sum(items) if any(isinstance(t, Interval) for t in items) else sum(items)
+
+
+def _zero(v) -> bool:
+    return not isinstance(v, Interval) and np.ndim(v) == 0 and v == 0

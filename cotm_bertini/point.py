@@ -302,16 +302,16 @@ def solve_framework_point(
 
 def check_route(model, settings: Settings, what: str = "solve") -> None:
     """Refuse a route the model cannot take, or a setting it would not honour, before any work
-    or folder (ParameterError). `what`: "solve", or "sweep" / "map" (the paper's mechanism is
-    swept by Bertini only)."""
+    or folder (ParameterError). `what`: "solve", or one of PAPER_BERTINI_ONLY (what the paper's
+    mechanism does by Bertini only)."""
     if not isinstance(model, Params):
         framework_route(model, settings)
     elif settings.route == "real":
-        if what != "solve":
+        if what in PAPER_BERTINI_ONLY:
             raise ParameterError(
-                f"route = 'real': a {what} of the paper's mechanism is solved by Bertini (its "
-                "continuation follows complex roots too); solve one point with route='real', "
-                "or sweep examples/cotm.toml, which takes the real route"
+                f"route = 'real': {what} of the paper's mechanism is by Bertini only "
+                f"({PAPER_BERTINI_ONLY[what]}); solve one point with route='real', or use "
+                "examples/cotm.toml, the same mechanism as a framework"
             )
         for name in PAPER_REAL_REFUSED:
             if getattr(settings, name) != getattr(Settings(engine="homotopy"), name):
@@ -319,6 +319,14 @@ def check_route(model, settings: Settings, what: str = "solve") -> None:
                     f"{name} = {getattr(settings, name)!r} with route = 'real': the real route "
                     "runs no Bertini (a branch and bound over the angles, in this process)"
                 )
+
+
+# What the paper's mechanism does on Bertini's complex roots only, and why.
+PAPER_BERTINI_ONLY = {
+    "sweep": "its continuation and events follow complex roots: a real sweep loses its folds",
+    "map": "its fold curves and regions follow complex roots",
+    "verify": "it compares every complex root with the resultant's and PHCpack's",
+}
 
 
 # Settings that only reach Bertini: the real route cannot honour them (`timeout` it does; it

@@ -38,7 +38,8 @@ SOLUTIONS = {
     "paper_stable": "the paper's criterion, for comparison only: every eigenvalue of the Jacobian "
     "of its tan-half equations has a negative real part (not a mechanical criterion)",
     "gamma1_imag_deg, gamma2_imag_deg": "imaginary parts of the complex angles (0 for real rows)",
-    "paths": "the path numbers that ended at this solution (-1: computed in closed form)",
+    "paths": "the path numbers that ended at this solution (-1: computed in closed form; on "
+    'the real route, `route="real"`, no path: the search\'s number of the root, from 0)',
     "<var>_re, <var>_im": "the solver's variables (c1, s1, c2, s2, and d1, d2 where a spring has "
     "L0 > 0) as computed",
     "certified": "after `--certify` / cb.certify only: a unique solution of the polynomial system "
@@ -253,7 +254,8 @@ FRAMEWORK = {
     "multiplicity": "how many path endpoints reached this solution (a spatial body's q and -q "
     "are reached by paths of their own: counted once)",
     "taut_set": "the cables taut in the polynomial system that gave this row",
-    "paths": "the path numbers that reached it (for a spatial body, those to q and to -q)",
+    "paths": "the path numbers that reached it (for a spatial body, those to q and to -q; on "
+    "the real route the search's number of the root, from 0)",
 }
 
 FRAMEWORK_COUNTS = {

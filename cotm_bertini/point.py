@@ -136,14 +136,18 @@ def solve_point(
 
     The `cli` engine runs Bertini in `folder` (which must be empty; a temporary one when None)
     and leaves its files there; the homotopy engine writes nothing. `warm` (the `warm` of a
-    neighbouring point's solution) lets the homotopy engine continue from that point.
+    neighbouring point's solution) lets the homotopy engine continue from that point. With
+    `settings.route == "real"` no Bertini runs: the real route's search finds and proves the
+    real equilibria (`_paper_real`), classified in the same columns.
     """
     check_route(params, settings)
     t = Timings()
     with t.stage("derive"):
         ps = parametric_system(params.zfl)
         system = ps.instantiate([getattr(params, n) for n in ps.parameters])
-    if settings.engine == "homotopy":
+    if settings.route == "real":
+        solved = _paper_real(params, settings, tolerances, t)
+    elif settings.engine == "homotopy":
         solved = _homotopy(params, settings, ps, t, warm)
     elif folder is None:
         with tempfile.TemporaryDirectory(prefix="cotm-") as tmp:
@@ -155,9 +159,13 @@ def solve_point(
         table = classify_columns(params, endpoints, tolerances)
         morse = morse_check(params, table)
     counts = path_counts(endpoints, table, tracked, lost, details.get("crossings_unresolved", 0))
+    if "real_search" in details:  # no path: the endpoints are the search's critical points
+        counts.update(finite_endpoints=0, infinite_or_failed_paths=0,
+                      boxes=details["real_search"]["boxes"])  # fmt: skip
     status, warnings = _checks(
         morse, counts, details.get("homotopy", {}).get("generic_warnings", [])
-    )
+        + details.get("framework_warnings", []),
+    )  # fmt: skip
     shape = {
         "variables": list(system.variables),
         "functions": list(system.names),
@@ -184,6 +192,33 @@ def _homotopy(params: Params, settings: Settings, ps, t: Timings, warm) -> tuple
                "crossings_unresolved": in_solve(hs.info)}  # fmt: skip
     info = hs.info
     return hs.endpoints, info["tracked"], info["lost"], engine, details, hs.input_text, hs.warm
+
+
+def _paper_real(params: Params, settings: Settings, tolerances: Tolerances, t: Timings):
+    """The paper's mechanism by the real route: its framework (model.framework.paper) searched
+    as any torus framework is (`_solve_real`), each equilibrium then handed on as an endpoint of
+    the paper's own system (c, s and the spring lengths d), so that it is refined, classified
+    and Morse-checked as Bertini's endpoints are. The framework's own warnings (undecided
+    boxes, its Morse count from the search's cone points) are kept beside the paper's checks."""
+    from .model.equations import variables_for
+    from .model.framework.paper import ANGLE_COLUMNS, paper_framework
+    from .model.kinematics import spring_vectors
+
+    sol = _solve_real(paper_framework(params), settings, tolerances, t)
+    g1, g2 = (np.radians(np.asarray(sol.columns[c], dtype=float)) for c in ANGLE_COLUMNS)
+    c1, s1, c2, s2 = np.cos(g1), np.sin(g1), np.cos(g2), np.sin(g2)
+    vec = spring_vectors(params, c1, s1, c2, s2)
+    value = {"c1": c1, "s1": s1, "c2": c2, "s2": s2,
+             "d1": np.hypot(*vec["spring1"]), "d2": np.hypot(*vec["spring2"])}  # fmt: skip
+    variables = variables_for(params.zfl)
+    n = len(g1)
+    records = [{"coords": [value[v][k] for v in variables], "path_number": k} for k in range(n)]
+    endpoints = Endpoints.from_records(variables, records)
+    details = {"route": "real", "real_search": sol.details["real_search"],
+               "framework_warnings": list(sol.warnings)}  # fmt: skip
+    if sol.continua:
+        details["continua"] = list(sol.continua)
+    return endpoints, 0, 0, sol.engine, details, "", None
 
 
 def _cli(params: Params, settings: Settings, system, folder: Path, title: str, t: Timings):
@@ -265,17 +300,42 @@ def solve_framework_point(
     )  # fmt: skip
 
 
-def check_route(model, settings: Settings) -> None:
-    """Refuse a route the model cannot take, before any work or folder (ParameterError)."""
-    if isinstance(model, Params):
-        if settings.route == "real":
-            raise ParameterError(
-                "route = 'real': the paper's mechanism is solved by Bertini (every complex root, "
-                "0.4 s); the same mechanism as a framework, examples/cotm.toml, takes the real "
-                "route"
-            )
-    else:
+def check_route(model, settings: Settings, what: str = "solve") -> None:
+    """Refuse a route the model cannot take, or a setting it would not honour, before any work
+    or folder (ParameterError). `what`: "solve", or one of PAPER_BERTINI_ONLY (what the paper's
+    mechanism does by Bertini only)."""
+    if not isinstance(model, Params):
         framework_route(model, settings)
+    elif settings.route == "real":
+        if what in PAPER_BERTINI_ONLY:
+            raise ParameterError(
+                f"route = 'real': {what} of the paper's mechanism is by Bertini only "
+                f"({PAPER_BERTINI_ONLY[what]}); solve one point with route='real', or use "
+                "examples/cotm.toml, the same mechanism as a framework"
+            )
+        for name in PAPER_REAL_REFUSED:
+            if getattr(settings, name) != getattr(Settings(engine="homotopy"), name):
+                raise ParameterError(
+                    f"{name} = {getattr(settings, name)!r} with route = 'real': the real route "
+                    "runs no Bertini (a branch and bound over the angles, in this process)"
+                )
+
+
+# What the paper's mechanism does on Bertini's complex roots only, and why.
+PAPER_BERTINI_ONLY = {
+    "sweep": "its continuation and events follow complex roots: a real sweep loses its folds",
+    "map": "its fold curves and regions follow complex roots",
+    "verify": "it compares every complex root with the resultant's and PHCpack's",
+}
+
+
+# Settings that only reach Bertini: the real route cannot honour them (`timeout` it does; it
+# runs in one thread, so `threads` is kept as a bound, as a sweep's workers set it).
+PAPER_REAL_REFUSED = (
+    "engine", "mptype", "precision", "final_tol", "tracktol_before_eg", "tracktol_during_eg",
+    "security_level", "condnum_threshold", "max_norm", "bertini", "extra_config",
+    "variable_groups", "scheduler",
+)  # fmt: skip
 
 
 def framework_route(fw, settings: Settings) -> str:

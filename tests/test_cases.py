@@ -5,14 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from conftest import solved
-from paper_tables import K_RATIO, TABLE2, TABLE2_COMPLEX, TABLE3, TABLE4
+from paper_tables import K_RATIO, TABLE2, TABLE2_COMPLEX, TABLE3, TABLE4, match_rows, unit
 from physics import angle_distance, balance, energy_gradient_fd, mp_refine, points
-
-
-def _unit(text: str) -> float:
-    """One unit of the last printed decimal."""
-    decimals = len(text.split(".")[1]) if "." in text else 0
-    return 10.0**-decimals
 
 
 def test_case1_reproduces_table2_to_printed_digits():
@@ -35,8 +29,8 @@ def test_case1_reproduces_table2_to_printed_digits():
             for a, b in zip(real["gamma1_deg"], real["gamma2_deg"], strict=True)
         ]
         row = real.iloc[int(np.argmin(d))]
-        assert angle_distance(row["gamma1_deg"], g1) <= _unit(g1_text), (g1, row)
-        assert angle_distance(row["gamma2_deg"], g2) <= _unit(g2_text), (g2, row)
+        assert angle_distance(row["gamma1_deg"], g1) <= unit(g1_text), (g1, row)
+        assert angle_distance(row["gamma2_deg"], g2) <= unit(g2_text), (g2, row)
         ref1, ref2 = mp_refine(params, g1, g2)
         assert angle_distance(row["gamma1_deg"], ref1) < 1e-9
         assert angle_distance(row["gamma2_deg"], ref2) < 1e-9
@@ -70,20 +64,6 @@ def test_physical_equilibria_satisfy_balance_and_are_energy_critical(case):
         assert np.abs(grad).max() < 1e-6 * params.k1 * params.L3**2, grad
 
 
-def _match(table_rows, solutions):
-    """For each printed row, the nearest real solution and its distance in degrees."""
-    real = solutions[solutions["is_real"]]
-    out = []
-    for row in table_rows:
-        d = [
-            max(angle_distance(row[0], a), angle_distance(row[1], b))
-            for a, b in zip(real["gamma1_deg"], real["gamma2_deg"], strict=True)
-        ]
-        k = int(np.argmin(d))
-        out.append((d[k], real.iloc[k]))
-    return out
-
-
 def test_case2_table3_physical_rows_with_corrected_ratio():
     """With k2/k1 = 0.98909 (docs/paper.md) the physical rows of Table 3 are found within 0.02 deg.
 
@@ -92,7 +72,7 @@ def test_case2_table3_physical_rows_with_corrected_ratio():
     """
     result, _ = solved("case2", 2.81 * K_RATIO)
     rows = [TABLE3[i - 1] for i in (1, 2, 4, 6, 9, 11)]
-    for (dist, sol), printed in zip(_match(rows, result.table), rows, strict=True):
+    for (dist, sol), printed in zip(match_rows(rows, result.table), rows, strict=True):
         assert dist < 0.02, (printed, dist)
         assert sol["physical"]
         assert sol["d1"] == pytest.approx(printed[2], abs=2e-3)
@@ -111,7 +91,7 @@ def test_case3_table4_physical_rows_with_corrected_ratio():
     table[14] = (table[14][0], -69.8645, *table[14][2:])
     ids = (5, 11, 13, 14, 15, 18, 19, 21, 22, 25, 26, 28, 29)
     rows = [table[i - 1] for i in ids]
-    for (dist, sol), printed, i in zip(_match(rows, result.table), rows, ids, strict=True):
+    for (dist, sol), printed, i in zip(match_rows(rows, result.table), rows, ids, strict=True):
         assert dist < 0.02, (i, printed, dist)
         assert sol["physical"], i
         assert sol["d1"] == pytest.approx(printed[2], abs=2e-3), i

@@ -273,18 +273,36 @@ def test_a_lost_root_is_caught_by_the_morse_count(monkeypatch):
     assert any("Morse" in w for w in res.warnings)
 
 
-def test_route_real_is_refused_for_the_papers_mechanism(tmp_path):
-    """The paper's model is Bertini's (its mission): route='real' is refused, not ignored."""
-    with pytest.raises(cb.ParameterError, match="route = 'real': the paper's mechanism"):
-        cb.solve(cb.Params.case("case3"), route="real")
+def test_route_real_for_the_papers_mechanism_refuses_what_it_cannot_honour(tmp_path):
+    """The paper's model solves on the real route (tests/test_paper_real.py); a sweep, map or
+    verify of it (each follows or compares complex roots) and a Bertini-only setting with it
+    are refused before any work or folder, on the API and the command line."""
+    with pytest.raises(cb.ParameterError, match="final_tol = 1e-09 with route = 'real'"):
+        cb.solve(cb.Params.case("case3"), route="real", final_tol=1e-9)
+    with pytest.raises(cb.ParameterError, match="engine = 'cli' with route = 'real'"):
+        cb.solve(cb.Params.case("case3"), route="real", engine="cli")
     out = subprocess.run(
-        [sys.executable, "-m", "cotm_bertini.cli", "solve", "case3", "--route", "real",
+        [sys.executable, "-m", "cotm_bertini.cli", "sweep", "--param", "L01", "--route", "real",
          "--out", str(tmp_path)],
         capture_output=True, text=True, timeout=300,
     )  # fmt: skip
-    assert out.returncode == 2 and "route = 'real'" in out.stderr and not list(tmp_path.iterdir())
-    with pytest.raises(cb.ParameterError, match="route = 'real'"):  # before any folder
+    assert out.returncode == 2 and "route = 'real': sweep" in out.stderr
+    out = subprocess.run(
+        [sys.executable, "-m", "cotm_bertini.cli", "solve", "case1", "--route", "real",
+         "--mptype", "0", "--out", str(tmp_path)],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert out.returncode == 2 and "mptype = 0 with route = 'real'" in out.stderr
+    out = subprocess.run(
+        [sys.executable, "-m", "cotm_bertini.cli", "verify", "case1", "--route", "real",
+         "--out", str(tmp_path)],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert out.returncode == 2 and "route = 'real': verify" in out.stderr
+    with pytest.raises(cb.ParameterError, match="route = 'real': sweep"):  # before any folder
         cb.sweep(cb.Params(), "L01", [0.0, 1.0], route="real", out=tmp_path)
+    with pytest.raises(cb.ParameterError, match="route = 'real': map"):
+        cb.design_map(cb.Params(), (0, 14), (0, 14), 3, settings=cb.Settings(route="real"))
     fourbar = cb.Framework.from_toml(ROOT / "examples" / "fourbar.toml")
     with pytest.raises(cb.ParameterError, match="route = 'real'.*closed loop"):
         cb.sweep(fourbar, "L0", [0.4, 0.5], route="real", out=tmp_path)

@@ -198,6 +198,9 @@ def solve(
             record["cache"] = {"hit": True, "key": key, "solved": record.get("solved"),
                                "seconds": time.perf_counter() - start}  # fmt: skip
             return Solutions(params, settings, record, hit)
+    from ..point import check_route  # after the cache: a hit loads no numpy
+
+    check_route(params, settings)  # a refused request has no cached answer; refused here
     if settings.scheduler is not None:  # an address nobody answers: refused before any work
         from ..backends.dask_jobs import check_scheduler
 

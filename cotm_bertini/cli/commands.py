@@ -228,10 +228,13 @@ def verify(args: argparse.Namespace) -> int:
     from ..analysis.verify import verify as verify_routes
     from ..api.solutions import solve as solve_params
     from ..fs import write_json
+    from ..point import check_route
 
     params, label = params_from(args), label_of(args)
+    settings = settings_from(args)
+    check_route(params, settings, "verify")  # before any folder
     output = output_root(args.out) if args.out else None
-    res = solve_params(params, settings_from(args), label=label)
+    res = solve_params(params, settings, label=label)
     results = verify_routes(params, res.table, seed=args.seed or 1)
     text = _verify_text(f"{label} ({describe(params)})", res, results)
     print(text)

@@ -91,7 +91,8 @@ def add_route(p: argparse.ArgumentParser) -> None:
         choices=("real", "complex"),
         help="how a framework is solved: real (branch and bound over its body angles, real "
         "equilibria only, proved complete; circles and tori) or complex (every complex root of "
-        "every taut set); default: real where it covers the configuration space",
+        "every taut set); default: real where it covers the configuration space; the paper's "
+        "cases: Bertini, or the real route's search with --route real",
     )
 
 

@@ -65,8 +65,8 @@ def summary_head(record: dict, cached: bool = False) -> str:
     if engine["flavour"] == "real":
         return (
             f"{c['physical']} equilibria ({c['stable']} stable{apart}; {c['distinct_solutions']}"
-            f" real rows) by the real route: a branch and bound of {c['boxes']:,} boxes over the "
-            f"body angles; {seconds}"
+            f" real rows) by the real route: a branch and bound of {c['boxes']:,} boxes over its "
+            f"configuration space; {seconds}"
         )
     return (
         f"{c['distinct_solutions']} distinct finite solutions "

@@ -1,0 +1,195 @@
+"""The real route on products of spheres (issue 41): spatial frameworks whose nodes hang by bars
+from the ground, solved by the branch and bound over chart angles (backends/spheres.py), checked
+against routes that share no code with it: the plain-numpy statics of tests/tensegrity_physics.py
+(Newton on the Lagrange conditions from thousands of poses, and the Morse sum on (S^2)^nodes),
+and the charts' cover of the sphere checked with the inverse charts written here."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import tensegrity_physics as tp
+from conftest import ROOT
+from test_spatial_examples import reference, spatial
+
+import cotm_bertini as cb
+
+
+def _rows_against(res, ref: list, free: tuple, cables: list[str]) -> None:
+    """Every reference critical point is one row of the result (node coordinates to 1e-7),
+    with the same kind (Morse index: 0 a minimum, 2 nodes a maximum), energy and taut set."""
+    rows = res.physical
+    X = rows[[f"{n}.{c}" for n in free for c in "xyz"]].to_numpy(float)
+    assert len(rows) == len(ref)
+    top = 2 * len(free)
+    for p in ref:
+        (i,) = np.flatnonzero(np.abs(X - p["X"]).max(axis=1) < 1e-7)
+        row = rows.iloc[i]
+        assert int(row["index"]) == p["index"]
+        assert row["kind"] == ("min" if p["index"] == 0 else "max" if p["index"] == top
+                               else "saddle")  # fmt: skip
+        assert math.isclose(float(row["energy"]), p["energy"], rel_tol=1e-9, abs_tol=1e-12)
+        assert [bool(row[f"{c}.taut"]) for c in cables] == [c in p["taut"] for c in cables]
+
+
+def test_prism_slack_by_the_real_route_equals_the_independent_reference():
+    """The slack-cable prism (6 dimensions, 8 taut sets of 18-24 unknowns on the complex route):
+    8 equilibria, 1 stable, proved (every box decided), each one the reference's."""
+    fw = cb.Framework.from_toml(ROOT / "examples" / "prism_slack.toml")
+    res = cb.solve(fw, cache=False)
+    assert res.record["engine"]["flavour"] == "real"
+    assert res.status == "ok", res.warnings
+    search = res.record["details"]["real_search"]
+    assert search["undecided"] == 0 and search["boxes"] > 0
+    ref, _ = reference("prism_slack")
+    _rows_against(res, ref, spatial("prism_slack").free, [c.name for c in fw.cables])
+    assert int(res.counts["stable"]) == 1
+    assert res.record["morse"]["ok"] and res.record["morse"]["expected"] == 8
+
+
+TWO_STAGE = """
+name = "two_stage"
+dim = 3
+nodes = ["A", "B"]
+[parameters]
+h = 1.1
+h2 = 0.9
+[ground]
+a = [1.0, 0.0, 0.0]
+b = [-0.5, 0.8660254037844386, 0.0]
+c = [-0.5, -0.8660254037844386, 0.3]
+[[bars]]
+name = "s1"
+a = "ground.a"
+b = "A"
+length = "h"
+[[bars]]
+name = "s2"
+a = "A"
+b = "B"
+length = "h2"
+[[cables]]
+name = "ca"
+a = "A"
+b = "ground.b"
+k = 1.0
+L0 = 0.7
+[[cables]]
+name = "cb"
+a = "B"
+b = "ground.c"
+k = 2.0
+L0 = 0.5
+[[cables]]
+name = "cc"
+a = "B"
+b = "ground.a"
+k = 0.5
+L0 = 0.0
+[[cables]]
+name = "cd"
+a = "A"
+b = "ground.c"
+k = 0.3
+L0 = 0.0
+"""
+
+
+def test_a_second_stage_node_on_a_moving_sphere_equals_newton(tmp_path):
+    """Node B hangs from node A (a sphere about a moving point: the chain rule through A's
+    angles): the real route's rows equal the reference's Newton search, Morse sum 4."""
+    path = tmp_path / "two_stage.toml"
+    path.write_text(TWO_STAGE)
+    fw = cb.Framework.from_toml(path)
+    res = cb.solve(fw, cache=False)
+    assert res.status == "ok", res.warnings
+    ref_fw = tp.Spatial(
+        {"ground.a": [1.0, 0.0, 0.0], "ground.b": [-0.5, 0.8660254037844386, 0.0],
+         "ground.c": [-0.5, -0.8660254037844386, 0.3]},
+        ("A", "B"), (("ground.a", "A", 1.1), ("A", "B", 0.9)),
+        (("ca", "A", "ground.b", 1.0, 0.7), ("cb", "B", "ground.c", 2.0, 0.5),
+         ("cc", "B", "ground.a", 0.5, 0.0), ("cd", "A", "ground.c", 0.3, 0.0)),
+    )  # fmt: skip
+    rng = np.random.default_rng(5)
+    X, resid, H, A = tp.newton(ref_fw, tp.random_poses(ref_fw, 3000, rng, 1.0))
+    ref: list[dict] = []
+    for i in np.flatnonzero(resid < 1e-11):
+        if not any(np.abs(p["X"] - X[i]).max() < 1e-7 for p in ref):
+            d = ref_fw.lengths(X[i : i + 1])[0]
+            taut = tuple(c[0] for c, di in zip(ref_fw.cables, d, strict=True) if di > c[4])
+            ref.append({"X": X[i], "index": tp.morse_index(H[i], A[i]), "taut": taut,
+                        "energy": float(ref_fw.energy(X[i : i + 1])[0])})  # fmt: skip
+    assert sum((-1) ** p["index"] for p in ref) == 4  # (S^2)^2: the reference is complete
+    _rows_against(res, ref, ("A", "B"), ["ca", "cb", "cc", "cd"])
+
+
+def _inverse_charts(u: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Each direction's angles in chart A (poles on z) and in chart B (poles on x, its first
+    angle stored 8 higher), written here from the charts' definitions."""
+    a_a, b_a = np.arccos(u[:, 2]), np.arctan2(u[:, 1], u[:, 0])
+    a_b, b_b = np.arccos(u[:, 0]) + 8.0, np.arctan2(u[:, 2], u[:, 1])
+    return [(a_a, b_a), (a_b, b_b)]
+
+
+def _uncovered(u: np.ndarray) -> np.ndarray:
+    """The directions (unit rows) inside no chart box of backends.spheres.pieces with a
+    margin of 0.01 rad, by the inverse charts written here; where one is inside, the chart's
+    direction at those angles is checked to be it."""
+    from cotm_bertini.backends.spheres import directions, pieces
+
+    inside = np.zeros(len(u), dtype=bool)
+    for (a, b), chart in zip(_inverse_charts(u), ("A", "B"), strict=True):
+        for (alo, ahi), (blo, bhi) in pieces():
+            if (alo > 4) != (chart == "B"):
+                continue
+            full = chart == "A" and math.isclose(bhi - blo, 2 * np.pi)  # all around: no edge
+            for turn in (-2 * np.pi, 0.0, 2 * np.pi):  # b is periodic
+                bt = b + turn
+                pad = -1e-12 if full else 0.01
+                here = (a > alo + 0.01) & (a < ahi - 0.01) & (bt > blo + pad) & (bt < bhi - pad)
+                if here.any():
+                    got = np.stack(directions(a[here], bt[here])["u"], axis=1)
+                    np.testing.assert_allclose(got, u[here], atol=1e-12)
+                inside |= here
+    return u[~inside]
+
+
+def _directions() -> np.ndarray:
+    rng = np.random.default_rng(7)
+    u = rng.standard_normal((200_000, 3))
+    special = np.array([[0, 0, 1], [0, 0, -1], [1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0]])
+    return np.vstack([u / np.linalg.norm(u, axis=1)[:, None], special])
+
+
+def test_the_chart_boxes_cover_the_sphere_with_room_to_spare():
+    """200,000 random directions, the poles and points of the equator: each lies inside a
+    chart box with a margin (so a critical point on the edge of one chart is inside another)."""
+    left = _uncovered(_directions())
+    assert not len(left), left[:5]
+
+
+def test_charts_that_leave_a_gap_are_caught(monkeypatch):
+    """Chart B's squares shrunk to less than the caps the band leaves out: directions near the
+    poles are found uncovered (the cover test can fail)."""
+    from cotm_bertini.backends import spheres
+
+    monkeypatch.setattr(spheres, "CAP", spheres.BAND - 0.05)
+    assert len(_uncovered(_directions()))
+
+
+@pytest.mark.parametrize("name", ["prism"])
+def test_a_zero_free_length_prism_real_and_complex_routes_agree(name):
+    """examples/prism.toml (every cable of zero free length: one smooth system, solved by the
+    complex route within seconds) gives the same physical rows by both routes."""
+    fw = cb.Framework.from_toml(ROOT / "examples" / f"{name}.toml")
+    real = cb.solve(fw, route="real", cache=False)
+    complex_ = cb.solve(fw, route="complex", cache=False)
+    assert real.status == "ok", real.warnings
+    cols = [f"{n}.{c}" for n in fw.nodes for c in "xyz"]
+    a = real.physical.sort_values("energy")[cols].to_numpy(float)
+    b = complex_.physical.sort_values("energy")[cols].to_numpy(float)
+    assert a.shape == b.shape
+    gap = np.abs(a[:, None, :] - b[None]).max(axis=2)
+    assert gap.min(axis=1).max() < 1e-8 and gap.min(axis=0).max() < 1e-8

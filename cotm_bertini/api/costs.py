@@ -106,8 +106,8 @@ class Cost:
         """One line: the total work and its estimate (the first line of a solve)."""
         if self.route == "real":
             return (
-                f"{self.name}: the real route (a branch and bound over its configuration space, real "
-                "equilibria only, proved complete; no generic set to solve: seconds, not paths; "
+                f"{self.name}: the real route (a branch and bound over its configuration space, "
+                "real equilibria only, proved complete; no generic set to solve: seconds, not paths; "
                 "--route complex solves every complex root of every taut set instead)"
             )
         solved = [s for s in self.sets if not s.free]

@@ -5,7 +5,8 @@ real number x it stands for. Each operation computes its bounds in double precis
 them outwards: IEEE addition, multiplication, division and square root are correctly rounded
 (error at most half an ulp), so a step of |x| 2^-52 (at least one ulp) each way keeps the true
 result inside; sin, cos and non-integer powers (whose libm results are not guaranteed correctly
-rounded) are widened further (`_PAD_TRIG`, `_PAD_POW`). An unbounded or undefined result is [-inf, inf].
+rounded) are widened further (`_PAD_TRIG`, `_PAD_POW`). An unbounded or undefined result is
+[-inf, inf].
 
 It has the methods a framework's generated code calls (+ - * / **, sqrt, sin, cos: the same
 source `model.framework.ballcode` evaluates on arb balls), so one call of a generated function

@@ -3,6 +3,7 @@
 A structure is the framework's topology with a taut set of cables and its zero-free-length
 springs; its parametric system (in the slots) and generated numpy code are kept under the cache
 folder, keyed by a hash of the structure and of the derivation code, so a solve needs no sympy.
+A planar framework on a circle or torus is derived without sympy at all (planar.py).
 """
 
 from __future__ import annotations
@@ -50,6 +51,10 @@ def framework_system(fw: Framework, taut: tuple[str, ...], label: str = "") -> F
         return _LOADED[key]
 
     def fresh() -> Derived:
+        from .planar import derive_planar, planar_torus
+
+        if planar_torus(fw):  # exact polynomials in a few ms, no sympy (derive's equations)
+            return derive_planar(fw, tuple(sorted(taut)))
         from ...progress import Progress
         from .derive import derive
 

@@ -22,6 +22,7 @@ import sympy as sp
 
 from .spec import Framework, owner, point_names
 from .structure import Derived, Layout, layout, rotation_names
+from .structure import active_links as _active
 from .units import constants
 
 _AXES = "xyz"
@@ -88,10 +89,6 @@ class _Positions:
                 out = self.translation(ent) + self.rot[ent] * self.local(point)
             self.cache[point] = out
         return self.cache[point]
-
-
-def _active(fw: Framework, taut: tuple[str, ...]) -> list:
-    return [x for x in fw.links if x.kind == "spring" or (x.kind == "cable" and x.name in taut)]
 
 
 def _unknowns(fw: Framework, lay: Layout) -> tuple[list[str], list[str]]:

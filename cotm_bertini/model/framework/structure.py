@@ -64,6 +64,11 @@ def rotation_names(dim: int, body: str) -> list[str]:
     return [f"c_{body}", f"s_{body}"] if dim == 2 else [f"q{a}_{body}" for a in "wxyz"]
 
 
+def active_links(fw: Framework, taut: tuple[str, ...]) -> list:
+    """The springs and the taut cables, in the file's order (the links that pull)."""
+    return [x for x in fw.links if x.kind == "spring" or (x.kind == "cable" and x.name in taut)]
+
+
 def structure(fw: Framework, taut: tuple[str, ...]) -> dict:
     """What the equations depend on: topology, taut cables, zero free lengths, constant slots."""
     return {
@@ -100,6 +105,7 @@ _SOURCES = tuple(
     Path(__file__).resolve().parent.parent / f
     for f in (
         "framework/derive.py",
+        "framework/planar.py",
         "framework/structure.py",
         "framework/spec.py",
         "framework/units.py",

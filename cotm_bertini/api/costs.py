@@ -107,8 +107,8 @@ class Cost:
         if self.route == "real":
             return (
                 f"{self.name}: the real route (a branch and bound over its configuration space, "
-                "real equilibria only, proved complete; no generic set to solve: seconds, not paths; "
-                "--route complex solves every complex root of every taut set instead)"
+                "real equilibria only, proved complete; no generic set to solve: seconds, not "
+                "paths; --route complex solves every complex root of every taut set instead)"
             )
         solved = [s for s in self.sets if not s.free]
         tracked = [s for s in solved if s.route != "monodromy"]  # paths counted beforehand

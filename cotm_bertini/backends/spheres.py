@@ -66,9 +66,10 @@ def _pick(mask: np.ndarray, a, b):
     return np.where(mask, a, b)
 
 
-def directions(a, b) -> dict[str, list]:
-    """u and its derivatives in the chart angles (u_a, u_b, u_aa, u_ab, u_bb), each three
-    components (Intervals or arrays), for angles (a, b) of either chart (module docstring)."""
+def directions(a, b, second: bool = True) -> dict[str, list]:
+    """u and its derivatives in the chart angles (u_a, u_b, and with `second` u_aa, u_ab,
+    u_bb), each three components (Intervals or arrays), for angles (a, b) of either chart
+    (module docstring)."""
     lo = a.lo if isinstance(a, Interval) else a
     turned = lo >= SHIFT / 2
     (sa, ca), (sb, cb) = _trig(a - SHIFT * turned), _trig(b)
@@ -77,11 +78,14 @@ def directions(a, b) -> dict[str, list]:
         "u": [sa * cb, sa * sb, ca],
         "ua": [ca * cb, ca * sb, -sa],
         "ub": [-(sa * sb), sa * cb, zero],
-        "uaa": [-(sa * cb), -(sa * sb), -ca],
-        "uab": [-(ca * sb), ca * cb, zero],
-        "ubb": [-(sa * cb), -(sa * sb), zero],
     }
+    if second:
+        out["uaa"] = [-c for c in out["u"]]
+        out["uab"] = [-(ca * sb), ca * cb, zero]
+        out["ubb"] = [-c for c in out["u"][:2]] + [zero]
     # Chart B is chart A with the axes turned: its (x, y, z) is A's (z, x, y).
+    if not turned.any():
+        return out
     return {k: [_pick(turned, v[p], v[c]) for c, p in enumerate((2, 0, 1))]
             for k, v in out.items()}  # fmt: skip
 
@@ -139,11 +143,12 @@ class SphereFramework:
         hanging from it, summed (three components)."""
         return [_total([g[3 * j + c] for j in self.subtree(node)]) for c in range(3)]
 
-    def kinematics(self, x) -> tuple[list, list]:
-        """(positions: three per node, directions per node) at boxes (Interval) or points."""
+    def kinematics(self, x, second: bool = True) -> tuple[list, list]:
+        """(positions: three per node, directions per node, with their second derivatives if
+        `second`) at boxes (Interval) or points."""
         dirs, pos = [], {}
         for i, v in enumerate(self.nodes):
-            d = directions(x[:, 2 * i], x[:, 2 * i + 1])
+            d = directions(x[:, 2 * i], x[:, 2 * i + 1], second)
             top = self.parent[v]
             if owner(top) == "ground":
                 g = top.split(".", 1)[1]
@@ -183,7 +188,7 @@ class SphereFramework:
     def enclose(self, box: Interval) -> tuple[Interval, Interval, dict]:
         """(squared lengths of the free-length springs, grad V in chart angles, cable states)."""
         count = box.lo.shape[0]
-        positions, dirs = self.kinematics(box)
+        positions, dirs = self.kinematics(box, second=False)
         g, dds, states = self.node_gradient(positions, count)
         grad = []
         for i, v in enumerate(self.nodes):

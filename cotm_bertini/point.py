@@ -351,6 +351,10 @@ def framework_route(fw, settings: Settings) -> str:
     return "complex" if why or settings.generic or settings.scheduler else "real"
 
 
+SEEDS_AT_BUDGET = 512  # Newton starts in the boxes a search stopped by its budget left
+DESCENTS = 64  # local descents from random poses when a search is stopped by its budget
+
+
 def _solve_real(fw, settings: Settings, tolerances: Tolerances, t: Timings) -> PointSolution:
     """Every real equilibrium of a framework on a circle or torus, by the branch and bound of
     backends.boxes over its body angles (backends.real_route), classified as the complex route's
@@ -378,9 +382,13 @@ def _solve_real(fw, settings: Settings, tolerances: Tolerances, t: Timings) -> P
         # Critical points the search could not prove: in boxes left undecided (a continuum
         # passes there) or set aside next to a cone point (a saddle leaves the cone point as
         # the other elements' pull there passes k L0): found by Newton, not proved unique.
-        seeds = land.fresh(np.vstack([critical_seeds(land, found.undecided),
+        # A search stopped by its budget leaves much undecided: more seeds, more rows found.
+        most = SEEDS_AT_BUDGET if found.budget_hit else 32
+        seeds = land.fresh(np.vstack([critical_seeds(land, found.undecided, most),
                                       critical_seeds(land, found.set_aside_boxes)]),
                            found.roots)  # fmt: skip
+        descents = _descents(land, found, seeds, settings.seed)
+        seeds = np.vstack([seeds, land.fresh(descents["points"], np.vstack([found.roots, seeds]))])
         groups = land.endpoints(np.vstack([found.roots, seeds]))
     report: dict = {" ".join(taut) or "none": {"excluded": True, "pruned": "bound smoothing",
                     "note": why.note()} for taut, why in pruned.items()}  # fmt: skip
@@ -394,6 +402,8 @@ def _solve_real(fw, settings: Settings, tolerances: Tolerances, t: Timings) -> P
     search_info = real_search_info(found, unit[0], along_continua(land, found, continua),
                                    morse_bott)  # fmt: skip
     search_info["found_by_newton"] = len(seeds)
+    if descents["starts"]:
+        search_info["descents"] = {k: v for k, v in descents.items() if k != "points"}
     warnings = tuple(search_info["warnings"] + checks["warnings"])
     counts = {**framework_counts(table, report, continua), "boxes": found.boxes}
     engine = {"flavour": "real", "path": "branch and bound (backends.boxes)", "version": ""}
@@ -404,6 +414,25 @@ def _solve_real(fw, settings: Settings, tolerances: Tolerances, t: Timings) -> P
         {"taut_sets": report, "real_search": search_info}, "", t.stages, None,
         tuple(continuum_record(c, n) for n, c in enumerate(continua, start=1)),
     )  # fmt: skip
+
+
+def _descents(land, found, seeds, seed: int | None) -> dict:
+    """Evidence for a search stopped by its budget (none otherwise): local descents from
+    DESCENTS random poses, the minima they reach, and how many of those the search or Newton
+    had already found (the others join the rows)."""
+    from .backends.real_route import descent_minima
+
+    if not found.budget_hit:
+        return {"starts": 0, "points": np.zeros((0, land.n))}
+    minima = land.fresh(descent_minima(land, DESCENTS, 0 if seed is None else seed),
+                        np.zeros((0, land.n)))  # fmt: skip
+    new = land.fresh(minima, np.vstack([found.roots, seeds]))
+    return {
+        "starts": DESCENTS,
+        "minima": len(minima),
+        "minima_not_found_before": len(new),
+        "points": minima,
+    }
 
 
 def _real_parts(fw, sets: list, groups: dict, report: dict, unit, tolerances) -> list:

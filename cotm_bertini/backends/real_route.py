@@ -29,7 +29,7 @@ from ..model.framework.spec import Framework
 from ..model.framework.structure import layout
 from ..model.framework.units import normalized_slots
 from ..model.intervals import Interval, stack
-from .boxes import MIN_WIDTH, SHORT, BoxSearch, search
+from .boxes import MIN_WIDTH, SHORT, BoxSearch, domain, search
 from .endpoints import Endpoints
 from .links import EITHER, SLACK, TAUT, columns, force_density, interval_sum, links
 from .spheres import SphereFramework
@@ -235,8 +235,11 @@ class TorusFramework:
 def critical_seeds(land: TorusFramework, boxes: np.ndarray, most: int = 32) -> np.ndarray:
     """Critical points near undecided or set-aside boxes (lo_1..lo_n, hi_1..hi_n): Newton with
     a least-squares step (the Hessian may be singular there: a continuum) from the middles of
-    at most `most` of them (`coarse_pick`); the ends where |grad V| < 1e-10."""
+    at most `most` of them (`coarse_pick`); the ends where |grad V| < 1e-10. A landscape in
+    charts moves each point to a chart regular there after every step (`rechart`: Newton
+    stays away from a chart's poles, where a component of grad V vanishes by itself)."""
     n = land.n
+    rechart = getattr(land, "rechart", lambda x: x)
     if not len(boxes):
         return np.zeros((0, n))
     pick = coarse_pick(boxes, most)
@@ -245,12 +248,38 @@ def critical_seeds(land: TorusFramework, boxes: np.ndarray, most: int = 32) -> n
     for _ in range(30):  # the points still moving only: most converge in a few steps
         g, h = land.derivatives(x[live])
         step = np.einsum("nij,nj->ni", np.linalg.pinv(h, rcond=1e-10), g)
-        x[live] -= step
+        x[live] = rechart(x[live] - step)
         live = live[np.isfinite(step).all(axis=1) & (np.abs(step).max(axis=1) > 1e-13)]
         if not len(live):
             break
     g, _ = land.derivatives(x)
     return x[np.isfinite(g).all(axis=1) & (np.abs(g).max(axis=1) < 1e-10)]
+
+
+def descent_minima(land, starts: int, seed: int, steps: int = 200) -> np.ndarray:
+    """Local minima of V reached from `starts` random points of the domain (seeded): Newton
+    steps where the Hessian is positive definite, else a gradient step of at most 0.2 rad,
+    each shortened until V's first-order decrease is kept (no energy is evaluated: the step
+    is damped instead); the ends with |grad V| < 1e-10 and a positive definite Hessian. Not a
+    proof: evidence, for a search stopped by its budget, that its rows hold every minimum the
+    descents find."""
+    rng = np.random.default_rng(seed)
+    lo, hi = domain(land, 8)
+    pick = rng.integers(0, len(lo), starts)
+    x = lo[pick] + rng.random((starts, land.n)) * (hi[pick] - lo[pick])
+    rechart = getattr(land, "rechart", lambda y: y)
+    for _ in range(steps):
+        g, h = land.derivatives(x)
+        with np.errstate(all="ignore"):
+            eig = np.linalg.eigvalsh(h)
+            newton = np.linalg.solve(np.where((eig > 0).all(axis=1)[:, None, None], h,
+                                              np.eye(land.n)), g[..., None])[..., 0]  # fmt: skip
+        step = np.where((eig > 0).all(axis=1)[:, None], newton, g)
+        step *= np.minimum(1.0, 0.2 / np.maximum(np.abs(step).max(axis=1), 1e-300))[:, None]
+        x = rechart(x - step)
+    g, h = land.derivatives(x)
+    good = (np.abs(g).max(axis=1) < 1e-10) & (np.linalg.eigvalsh(h) > 0).all(axis=1)
+    return x[good]
 
 
 def fresh_points(points: np.ndarray, known: np.ndarray, apart: float = 1e-8) -> np.ndarray:

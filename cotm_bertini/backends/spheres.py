@@ -277,6 +277,22 @@ class SphereFramework:
         """Node coordinates (R, 3 per node) at points (R, n chart angles)."""
         return np.stack(self.kinematics(x)[0], axis=1)
 
+    def rechart(self, x: np.ndarray) -> np.ndarray:
+        """Points (R, n chart angles) with each node in the chart where it is most regular:
+        chart A unless its direction lies within BAND of the z axis (then chart B, whose
+        squares hold it), by the inverse charts."""
+        out = np.empty_like(x)
+        for i in range(len(self.nodes)):
+            u = np.stack(directions(x[:, 2 * i], x[:, 2 * i + 1], False)["u"], axis=1)
+            u /= np.linalg.norm(u, axis=1)[:, None]
+            polar = np.abs(u[:, 2]) > math.cos(BAND)
+            b = np.arctan2(u[:, 1], u[:, 0])
+            b = np.where(b < OFFSET, b + 2 * math.pi, b)
+            out[:, 2 * i] = np.where(polar, np.arccos(np.clip(u[:, 0], -1, 1)) + SHIFT,
+                                     np.arccos(np.clip(u[:, 2], -1, 1)))  # fmt: skip
+            out[:, 2 * i + 1] = np.where(polar, np.arctan2(u[:, 2], u[:, 1]), b)
+        return out
+
     def fresh(self, points: np.ndarray, known: np.ndarray) -> np.ndarray:
         """The points that are neither at the pose of a `known` one nor of an earlier one."""
         kept: list[np.ndarray] = []

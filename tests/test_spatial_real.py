@@ -97,14 +97,8 @@ L0 = 0.0
 """
 
 
-def test_a_second_stage_node_on_a_moving_sphere_equals_newton(tmp_path):
-    """Node B hangs from node A (a sphere about a moving point: the chain rule through A's
-    angles): the real route's rows equal the reference's Newton search, Morse sum 4."""
-    path = tmp_path / "two_stage.toml"
-    path.write_text(TWO_STAGE)
-    fw = cb.Framework.from_toml(path)
-    res = cb.solve(fw, cache=False)
-    assert res.status == "ok", res.warnings
+def _two_stage_reference() -> list[dict]:
+    """TWO_STAGE's critical points by tensegrity_physics (Newton from 3,000 random poses)."""
     ref_fw = tp.Spatial(
         {"ground.a": [1.0, 0.0, 0.0], "ground.b": [-0.5, 0.8660254037844386, 0.0],
          "ground.c": [-0.5, -0.8660254037844386, 0.3]},
@@ -122,7 +116,35 @@ def test_a_second_stage_node_on_a_moving_sphere_equals_newton(tmp_path):
             ref.append({"X": X[i], "index": tp.morse_index(H[i], A[i]), "taut": taut,
                         "energy": float(ref_fw.energy(X[i : i + 1])[0])})  # fmt: skip
     assert sum((-1) ** p["index"] for p in ref) == 4  # (S^2)^2: the reference is complete
-    _rows_against(res, ref, ("A", "B"), ["ca", "cb", "cc", "cd"])
+    return ref
+
+
+def test_a_second_stage_node_on_a_moving_sphere_equals_newton(tmp_path):
+    """Node B hangs from node A (a sphere about a moving point: the chain rule through A's
+    angles): the real route's rows equal the reference's Newton search, Morse sum 4."""
+    path = tmp_path / "two_stage.toml"
+    path.write_text(TWO_STAGE)
+    res = cb.solve(cb.Framework.from_toml(path), cache=False)
+    assert res.status == "ok", res.warnings
+    _rows_against(res, _two_stage_reference(), ("A", "B"), ["ca", "cb", "cc", "cd"])
+
+
+def test_a_search_stopped_by_its_budget_is_incomplete_and_its_rows_are_genuine(tmp_path):
+    """Stopped after 0.2 s: status incomplete, the undecided share stated, descents run; and
+    every row it gives (proved, or found by Newton from undecided boxes or by descents) is one
+    of the reference's critical points (Newton in charts once ended on a chart's pole, where a
+    gradient component vanishes by itself: false rows)."""
+    path = tmp_path / "two_stage.toml"
+    path.write_text(TWO_STAGE)
+    res = cb.solve(cb.Framework.from_toml(path), cache=False, timeout=0.2)
+    assert res.status == "incomplete"
+    search = res.record["details"]["real_search"]
+    assert search["undecided_share"] > 0 and search["descents"]["starts"] == 64
+    ref = _two_stage_reference()
+    X = res.physical[[f"{n}.{c}" for n in "AB" for c in "xyz"]].to_numpy(float)
+    assert len(X)
+    for x in X:
+        assert min(np.abs(p["X"] - x).max() for p in ref) < 1e-7, x
 
 
 def _inverse_charts(u: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:

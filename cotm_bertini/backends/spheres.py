@@ -178,10 +178,11 @@ class SphereFramework:
             w, state = force_density(x, dd)
             if x.cable:
                 states[x.name] = state
+            wr = [w * c for c in r]  # w r once: dr/dX of a node's coordinate is +-1 or 0
             for j in range(m):
-                terms = [r[c] * dr[c * m + j] for c in range(3) if not _zero(dr[c * m + j])]
+                terms = [wr[c] * dr[c * m + j] for c in range(3) if not _zero(dr[c * m + j])]
                 if terms:
-                    g[j] = g[j] + w * interval_sum(terms)
+                    g[j] = g[j] + interval_sum(terms)
             dds.append(dd)
         return g, dds, states
 

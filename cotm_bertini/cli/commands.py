@@ -379,7 +379,7 @@ def plan(args: argparse.Namespace) -> int:
 
 def _workers(args: argparse.Namespace) -> int:
     """--workers, or one per core; refused below 1."""
-    from ..continuation.runner import default_workers
+    from ..backends.pools import default_workers
 
     workers = default_workers() if args.workers is None else args.workers
     if workers < 1:

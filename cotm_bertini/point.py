@@ -226,6 +226,7 @@ def solve_framework_point(
             f"engine = {settings.engine!r}: a framework is solved by the in-process homotopy "
             "engine (engine='homotopy')"
         )
+    check_route(fw, settings)
     t = Timings()
     with t.stage("derive"):
         # Free even with every cable taut: a continuum of equilibria, refused as bad input.
@@ -265,8 +266,16 @@ def solve_framework_point(
     )  # fmt: skip
 
 
-def check_route(model, settings: Settings) -> None:
-    """Refuse a route the model cannot take, before any work or folder (ParameterError)."""
+def check_route(model, settings: Settings, points: bool = False) -> None:
+    """Refuse a route the model cannot take, or local workers where nothing would use them,
+    before any work or folder (ParameterError; `points`: a sweep's or map's, each point solved
+    in one process)."""
+    workers = settings.workers not in (None, 1)
+    if points and settings.workers is not None:
+        raise ParameterError(
+            f"workers = {settings.workers!r} in the settings: a sweep or map solves each point "
+            "in one process and splits its points over its own workers (workers=, --workers)"
+        )
     if isinstance(model, Params):
         if settings.route == "real":
             raise ParameterError(
@@ -274,8 +283,17 @@ def check_route(model, settings: Settings) -> None:
                 "0.4 s); the same mechanism as a framework, examples/cotm.toml, takes the real "
                 "route"
             )
-    else:
-        framework_route(model, settings)
+        if workers:
+            raise ParameterError(
+                f"workers = {settings.workers!r}: the paper's mechanism is solved by one "
+                "Bertini process (threads= sets its threads)"
+            )
+    elif framework_route(model, settings) == "complex" and workers:
+        raise ParameterError(
+            f"workers = {settings.workers!r}: local workers share the real route's boxes; the "
+            f"complex route of {model.name} is not split over them (a scheduler splits its "
+            "generic sets' paths)"
+        )
 
 
 def framework_route(fw, settings: Settings) -> str:
@@ -288,7 +306,7 @@ def framework_route(fw, settings: Settings) -> str:
         raise ParameterError(f"route = 'real': not yet for {fw.name}: {why}; use route='complex'")
     if settings.route is not None:
         return settings.route
-    return "complex" if why or settings.generic or settings.scheduler else "real"
+    return "complex" if why or settings.generic else "real"
 
 
 def _solve_real(fw, settings: Settings, tolerances: Tolerances, t: Timings) -> PointSolution:
@@ -299,22 +317,25 @@ def _solve_real(fw, settings: Settings, tolerances: Tolerances, t: Timings) -> P
     curve no box can be decided), traced and counted apart as on the complex route."""
     from .analysis.framework_checks import completeness, framework_counts, order_rows
     from .analysis.framework_continua import absorb, continuum_record, find_continua
-    from .backends.boxes import SHORT, search
-    from .backends.real_route import TorusFramework, critical_seeds, fresh_points
+    from .backends.box_shares import split_search
+    from .backends.boxes import SHORT
+    from .backends.real_route import critical_seeds, fresh_points, landscape
     from .model.framework.compiled import check_terms
     from .model.framework.units import normalized_slots, units
 
     unit = units(fw)
     sets, pruned = split_taut_sets(fw)
     with t.stage("derive"):
-        land = TorusFramework(fw)
+        land = landscape(fw)
         target = normalized_slots(fw)
         for taut, fs in land.hessian_sets:  # derived (or loaded) here, not in the search's clock
             if taut in sets:
                 check_terms(fw, fs, target)  # a degenerate equation: refused, not searched
     with t.stage("solve"):
-        found = search(land, SHORT, MIN_WIDTH, max_seconds=settings.timeout,
-                       label=f"real search of {fw.name}")  # fmt: skip
+        # Shared over local processes or a Dask cluster where asked (each rebuilds `land`).
+        found = split_search(landscape, fw, SHORT, MIN_WIDTH, workers=settings.workers or 1,
+                             scheduler=settings.scheduler, max_seconds=settings.timeout,
+                             label=f"real search of {fw.name}")  # fmt: skip
         # Critical points the search could not prove: in boxes left undecided (a continuum
         # passes there) or set aside next to a cone point (a saddle leaves the cone point as
         # the other elements' pull there passes k L0): found by Newton, not proved unique.
@@ -409,6 +430,8 @@ def real_search_info(found, length_unit: float, along: int = 0, morse_bott: bool
     return {
         "boxes": found.boxes,
         "seconds": round(found.seconds, 4),
+        "cpu_seconds": round(found.cpu_seconds, 4),
+        "shares": found.shares,
         "roots": len(found.roots),
         "set_aside": found.set_aside,
         "set_aside_longest_spring": found.set_aside_bound * length_unit,

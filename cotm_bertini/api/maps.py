@@ -115,7 +115,7 @@ def design_map(
     xs, ys = grid_values(*xr, points), grid_values(*yr, points)
     check_grid(model, x, tuple(map(float, xs)), y, tuple(map(float, ys)))  # every point too
     check_workers(workers)  # before any process starts
-    check_route(model, settings or Settings())
+    check_route(model, settings or Settings(), points=True)
     key = _map_key(model, (x, xr), (y, yr), points, settings)
     made = _made_before(model, key, (x, y))
     if made is not None:

@@ -143,7 +143,7 @@ def sweep(
 
     check_workers(workers)  # before any folder is made
     settings = (settings or Settings()).replace(**options)
-    check_route(params, settings)
+    check_route(params, settings, points=True)
     framework = None
     if not isinstance(params, Params):  # a cb.Framework: its parameters are swept
         from ..continuation.framework import encode

@@ -245,12 +245,21 @@ def _rows(parts: list, n: int) -> np.ndarray:
 
 
 def _take(stack: list, count: int) -> tuple[np.ndarray, np.ndarray]:
-    """Up to `count` boxes from the top of the stack (depth first keeps it short)."""
-    lo, hi = stack.pop()
-    if len(lo) > count:
-        stack.append((lo[:-count], hi[:-count]))
-        lo, hi = lo[-count:], hi[-count:]
-    return lo, hi
+    """Up to `count` boxes from the top of the stack (depth first keeps it short), from as
+    many of its entries as it takes: a step of few boxes costs numpy's overhead all the same."""
+    los, his, have = [], [], 0
+    while stack and have < count:
+        lo, hi = stack.pop()
+        if have + len(lo) > count:
+            cut = len(lo) - (count - have)
+            stack.append((lo[:cut], hi[:cut]))
+            lo, hi = lo[cut:], hi[cut:]
+        los.append(lo)
+        his.append(hi)
+        have += len(lo)
+    if len(los) == 1:
+        return los[0], his[0]
+    return np.vstack(los), np.vstack(his)
 
 
 def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, acc: dict):

@@ -64,13 +64,14 @@ def test_two_workers_prove_what_one_does(reference, serial, monkeypatch, capfd):
     monkeypatch.setenv(progress.ENV_SECONDS, "0")
     one, two = serial, cb.solve(fw, cache=False, workers=2)
     err = capfd.readouterr().err
-    line = r"real search of chain3: \d+% of the poses decided, [\d,]+ boxes, \d/8 shares; "
+    line = r"real search of chain3: \d+% of the poses decided, [\d,]+ boxes, \d/2 shares; "
     assert re.search(line + r".* so far, about .* left", err), err
     for res in (one, two):
         _matches_reference(res, reference)
     _same_tables(one.table, two.table)
     a, b = (r.record["details"]["real_search"] for r in (one, two))
-    assert (a["shares"], b["shares"], two.record["settings"]["workers"]) == (1, 8, 2)
+    # chain3's 512 start boxes fill no 4,096-box batch step: one share a worker.
+    assert (a["shares"], b["shares"], two.record["settings"]["workers"]) == (1, 2, 2)
     for key in ("boxes", "roots", "set_aside", "undecided", "found_by_newton"):
         assert a[key] == b[key], key
     assert b["cpu_seconds"] > 0 and b["seconds"] > 0
@@ -96,11 +97,17 @@ def test_shares_merge_box_for_box_and_a_lost_one_shows(reference, monkeypatch):
     assert 0 < len(short.roots) < len(reference.theta)
     with pytest.raises(AssertionError):
         _pairing(np.degrees(np.mod(short.roots, 2 * np.pi)), np.degrees(reference.theta))
-    # The pool's results with share 3 dropped: refused, not merged into a smaller proof.
+    # Four shares a worker where the start boxes would fill the batch steps (here: smaller
+    # steps asked for): the same record from two local processes.
+    monkeypatch.setattr(box_shares, "BATCH", 128)
+    eight = box_shares.split_search(landscape, fw, SHORT, MIN_WIDTH, workers=2)
+    np.testing.assert_allclose(eight.roots, joined.roots, rtol=0, atol=SAME)
+    assert (eight.boxes, eight.set_aside, eight.shares) == (whole.boxes, whole.set_aside, 8)
+    # The pool's results with share 1 dropped: refused, not merged into a smaller proof.
     real = box_shares.as_done
-    lossy = lambda *a: ((k, r) for k, r in real(*a) if k != 3)  # noqa: E731
+    lossy = lambda *a: ((k, r) for k, r in real(*a) if k != 1)  # noqa: E731
     monkeypatch.setattr(box_shares, "as_done", lossy)
-    gap = r"cover 0.875 of the domain, not all of it \(shares \[3\] of 8 never came back"
+    gap = r"cover 0.875 of the domain, not all of it \(shares \[1\] of 8 never came back"
     with pytest.raises(cb.SolverError, match=gap):
         box_shares.split_search(landscape, fw, SHORT, MIN_WIDTH, workers=2)
 
@@ -141,11 +148,11 @@ def scheduler():
 
 def test_dask_cluster_proves_what_one_process_does(reference, serial, scheduler):
     """chain3 solved with its boxes on a two-process Dask cluster: the rows of the serial
-    solve (1e-8) and the reference's, from 4 shares a worker."""
+    solve (1e-8) and the reference's, one share a worker."""
     fw = cb.Framework.from_toml(FILE)
     one, dask = serial, cb.solve(fw, cache=False, scheduler=scheduler)
     _matches_reference(dask, reference)
     _same_tables(one.table, dask.table)
     a, b = (r.record["details"]["real_search"] for r in (one, dask))
-    assert b["shares"] == 8 and a["boxes"] == b["boxes"] and a["roots"] == b["roots"]
+    assert b["shares"] == 2 and a["boxes"] == b["boxes"] and a["roots"] == b["roots"]
     assert dask.record["engine"]["flavour"] == "real"

@@ -19,10 +19,13 @@ import numpy as np
 from ..errors import SolverError
 from ..model.intervals import Interval
 from ..progress import Progress, silenced
-from .boxes import BoxLandscape, BoxSearch, domain, merged, search, spread
+from .boxes import BATCH, BoxLandscape, BoxSearch, domain, merged, search, spread
 from .pools import as_done
 
-SHARES_A_WORKER = 4  # a worker done early takes another share; the progress moves in these
+# A worker done early takes another share, and the progress moves a share at a time; but each
+# share walks its boxes down in as many batch steps as the whole search (about 1 ms of numpy's
+# overhead each): more than one share a worker only where the start boxes fill BATCH-box steps.
+SHARES_A_WORKER = 4
 BOXES_A_SHARE = 16  # breadth-first steps until there are this many boxes a share to deal
 SPREAD_STEPS = 8  # ... at most (a 1-D domain of 8 boxes: 16 a share after a few steps)
 
@@ -55,7 +58,7 @@ def split_search(
     dealt: dict = {}  # what the breadth-first steps decided here, and the shares dealt
 
     def jobs(count: int) -> list[tuple]:
-        shares = max(1, count) * SHARES_A_WORKER
+        shares = max(1, count) * min(SHARES_A_WORKER, max(1, len(first[0]) // BATCH))
         (lo, hi), done = spread(land, first, short, min_width, shares * BOXES_A_SHARE,
                                 SPREAD_STEPS)  # fmt: skip
         dealt["head"] = dataclasses.replace(done, shares=0, volume=volume)
@@ -68,7 +71,7 @@ def split_search(
 
     finished = as_done(_search_share, jobs, workers, scheduler)  # local processes start now
     parts: dict[int, BoxSearch] = {}
-    with Progress(label, 1.0, "of the poses decided") as report:
+    with Progress(label, 1.0, "of the poses decided", heartbeat=True) as report:
         for k, part in finished:
             parts[k] = part
             boxes = dealt["head"].boxes + sum(p.boxes for p in parts.values())

@@ -187,11 +187,9 @@ def solve(
     `folder` attribute holds what the solver left (input, output, failed attempts, run.json).
     """
     from ..io import cache as solve_cache
-    from ..point import check_route
 
     start = time.perf_counter()
     settings = (settings or Settings()).replace(**options)
-    check_route(params, settings)  # before any work or folder
     tol = _tolerances(tolerances)
     key = solve_cache.request_key(params.key_fields(), settings.result_key(), tol)
     if cache:
@@ -201,6 +199,9 @@ def solve(
             record["cache"] = {"hit": True, "key": key, "solved": record.get("solved"),
                                "seconds": time.perf_counter() - start}  # fmt: skip
             return Solutions(params, settings, record, hit)
+    from ..point import check_route  # here: a cache hit loads no numpy
+
+    check_route(params, settings)  # before any work or folder
     if settings.scheduler is not None:  # an address nobody answers: refused before any work
         from ..backends.dask_jobs import check_scheduler
 

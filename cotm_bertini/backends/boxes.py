@@ -185,10 +185,8 @@ def _record(n: int, acc: dict, found: tuple, clocks: tuple, budget: str, volume:
     """A BoxSearch from the tally, (roots, their boxes, undecided parts), the wall and CPU
     clocks at the start."""
     roots, root_boxes, undecided = found
-    roots, root_boxes = np.array(roots).reshape(-1, n), np.array(root_boxes).reshape(-1, 2 * n)
-    order = _ordered(roots)
     return BoxSearch(
-        roots[order], root_boxes[order], acc["failed"],
+        np.array(roots).reshape(-1, n), np.array(root_boxes).reshape(-1, 2 * n), acc["failed"],
         acc["aside"], acc["bound"], _rows(acc["aside_boxes"], n), _rows(undecided, n),
         acc["boxes"], time.perf_counter() - clocks[0], acc["shortest"], budget, volume=volume,
         cpu_seconds=time.process_time() - clocks[1],
@@ -221,8 +219,9 @@ def merged(parts: list[BoxSearch], volume: float, seconds: float, apart: float =
 
 
 def _ordered(roots: np.ndarray) -> np.ndarray:
-    """The roots' order by their angles (first, then second, ...): one order whichever
-    batches or shares found them."""
+    """The roots' order by their angles (first, then second, ...): one order whichever shares
+    came back first (the search in one process keeps the order it found them in: fold seeds
+    follow it)."""
     return np.lexsort(roots.T[::-1]) if len(roots) else np.zeros(0, dtype=np.int64)
 
 

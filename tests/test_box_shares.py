@@ -158,3 +158,13 @@ def test_dask_cluster_proves_what_one_process_does(reference, serial, scheduler)
     a, b = (r.record["details"]["real_search"] for r in (one, dask))
     assert b["shares"] == 2 and a["boxes"] == b["boxes"] and a["roots"] == b["roots"]
     assert dask.record["engine"]["flavour"] == "real"
+
+
+def test_a_time_limit_stops_every_share_and_says_so():
+    """timeout holds for the shared search as a whole: both shares stop at the common deadline,
+    their boxes left are undecided, the status incomplete and the warning says how many
+    shares stopped."""
+    res = cb.solve(cb.Framework.from_toml(FILE), workers=2, timeout=0.05, cache=False)
+    found = res.record["details"]["real_search"]
+    assert res.status == "incomplete" and found["undecided"] > 0 and found["shares"] == 2
+    assert re.search(r"left \d+ boxes undecided .*2 of 2 shares stopped at", res.warnings[0])

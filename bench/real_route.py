@@ -2,8 +2,9 @@
 then the branch and bound) against a later one (derivations cached), end to end on the command
 line, each the best of three; the search's boxes and CPU time a box; and the paper's cases 1-3
 (cb.Params) by Bertini and by the real route, with the real route's proof against the
-parallel-curve certificate. Usage: python bench/real_route.py [--skip NAME ...] [--map] (--map
-adds the X-module's 41 x 41 map over L0c and fy, workers=2)."""
+parallel-curve certificate. Usage: python bench/real_route.py [--skip NAME ...] [--map]
+[--workers] (--map adds the X-module's 41 x 41 map over L0c and fy, workers=2; --workers
+measures chain3's and the X-module's search in one process and over two instead)."""
 
 from __future__ import annotations
 
@@ -113,11 +114,66 @@ def _xmodule_map() -> dict:
     return {"map_41x41_s": time.perf_counter() - t0, "status": m.status}
 
 
+def _shared(name: str, workers: int, repeat: int = 3) -> dict:
+    """The search of `name` shared over `workers` local processes (backends.box_shares), warm
+    (derivations cached, the landscape built): best wall of `repeat`, with that run's CPU in
+    every process; and the CLI solve end to end with --workers (best of `repeat`)."""
+    import cotm_bertini as cb
+    from cotm_bertini.backends.box_shares import split_search
+    from cotm_bertini.backends.boxes import MIN_WIDTH, SHORT
+    from cotm_bertini.backends.real_route import landscape
+
+    fw = cb.Framework.from_toml(ROOT / "examples" / f"{name}.toml")
+    landscape(fw).hessian_sets  # noqa: B018 (derived here, not in the search's clock)
+    runs = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        found = split_search(landscape, fw, SHORT, MIN_WIDTH, workers=workers)
+        runs.append((time.perf_counter() - t0, found))
+    wall, found = min(runs, key=lambda r: r[0])
+    largest = _largest_share_cpu(landscape(fw), found.shares) if workers > 1 else found.cpu_seconds
+    args = ["solve", "--framework", str(ROOT / "examples" / f"{name}.toml"), "--workers",
+            str(workers)]  # fmt: skip
+    solve = min(cli_seconds(args, dict(os.environ)) for _ in range(repeat))
+    return {"example": name, "workers": workers, "shares": found.shares, "boxes": found.boxes,
+            "roots": len(found.roots), "search_wall_s": wall, "search_cpu_s": found.cpu_seconds,
+            "boxes_per_s_wall": found.boxes / wall,
+            "boxes_per_cpu_s": found.boxes / found.cpu_seconds, "largest_share_cpu_s": largest,
+            "cli_solve_s": solve,
+            "load_avg_1min": os.getloadavg()[0]}  # fmt: skip
+
+
+def _largest_share_cpu(land, shares: int) -> float:
+    """The CPU of the largest of `shares` round-robin shares of the start boxes, each searched
+    here alone (best of 3): the wall time the shared search would take on free cores."""
+    from cotm_bertini.backends.boxes import MIN_WIDTH, SHORT, domain, search
+
+    lo, hi = domain(land, 8)
+    best = []
+    for k in range(shares):
+        runs = []
+        for _ in range(3):
+            c0 = time.process_time()
+            search(land, SHORT, MIN_WIDTH, boxes=(lo[k::shares], hi[k::shares]))
+            runs.append(time.process_time() - c0)
+        best.append(min(runs))
+    return max(best)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--skip", nargs="*", default=[])
     ap.add_argument("--map", action="store_true")
+    ap.add_argument("--workers", action="store_true", help="chain3 and the X-module: 1 and 2")
     args = ap.parse_args()
+    if args.workers:
+        frame = pd.DataFrame([_shared(n, w) for n in ("chain3", "xmodule") for w in (1, 2)])
+        show("real route: the search in one process and shared over two", frame,
+             {"search_wall_s": ".3f", "search_cpu_s": ".3f", "boxes_per_s_wall": ",.0f",
+              "boxes_per_cpu_s": ",.0f", "largest_share_cpu_s": ".3f", "cli_solve_s": ".2f",
+              "load_avg_1min": ".1f"})  # fmt: skip
+        write_csv(frame, "real_route_workers")
+        return
     rows = [_row(n) for n in EXAMPLES if n not in args.skip]
     frame = pd.DataFrame(rows)
     show("real route: first solve against a later one, the search's boxes", frame,

@@ -261,6 +261,7 @@ def solve_framework_point(
             f"engine = {settings.engine!r}: a framework is solved by the in-process homotopy "
             "engine (engine='homotopy')"
         )
+    check_route(fw, settings)
     t = Timings()
     with t.stage("derive"):
         # Free even with every cable taut: a continuum of equilibria, refused as bad input.
@@ -301,12 +302,30 @@ def solve_framework_point(
 
 
 def check_route(model, settings: Settings, what: str = "solve") -> None:
-    """Refuse a route the model cannot take, or a setting it would not honour, before any work
-    or folder (ParameterError). `what`: "solve", or one of PAPER_BERTINI_ONLY (what the paper's
-    mechanism does by Bertini only)."""
+    """Refuse a route the model cannot take, a setting it would not honour, or local workers
+    where nothing would use them, before any work or folder (ParameterError). `what`: "solve",
+    or one of PAPER_BERTINI_ONLY (a sweep or map solves each point in one process and splits
+    its points over its own workers)."""
+    workers = settings.workers not in (None, 1)
+    if what != "solve" and settings.workers is not None:
+        raise ParameterError(
+            f"workers = {settings.workers!r} in the settings: a sweep or map solves each point "
+            "in one process and splits its points over its own workers (workers=, --workers)"
+        )
     if not isinstance(model, Params):
-        framework_route(model, settings)
-    elif settings.route == "real":
+        if framework_route(model, settings) == "complex" and workers:
+            raise ParameterError(
+                f"workers = {settings.workers!r}: local workers share the real route's boxes; "
+                f"the complex route of {model.name} is not split over them (a scheduler splits "
+                "its generic sets' paths)"
+            )
+        return
+    if workers:
+        raise ParameterError(
+            f"workers = {settings.workers!r}: the paper's mechanism is solved in one process "
+            "(threads= sets Bertini's threads)"
+        )
+    if settings.route == "real":
         if what in PAPER_BERTINI_ONLY:
             raise ParameterError(
                 f"route = 'real': {what} of the paper's mechanism is by Bertini only "
@@ -348,7 +367,7 @@ def framework_route(fw, settings: Settings) -> str:
         raise ParameterError(f"route = 'real': not yet for {fw.name}: {why}; use route='complex'")
     if settings.route is not None:
         return settings.route
-    return "complex" if why or settings.generic or settings.scheduler else "real"
+    return "complex" if why or settings.generic else "real"
 
 
 SEEDS_AT_BUDGET = 512  # Newton starts in the boxes a search stopped by its budget left
@@ -363,7 +382,8 @@ def _solve_real(fw, settings: Settings, tolerances: Tolerances, t: Timings) -> P
     curve no box can be decided), traced and counted apart as on the complex route."""
     from .analysis.framework_checks import completeness, framework_counts, order_rows
     from .analysis.framework_continua import absorb, continuum_record, find_continua
-    from .backends.boxes import SHORT, search
+    from .backends.box_shares import split_search
+    from .backends.boxes import SHORT
     from .backends.real_route import critical_seeds, landscape
     from .model.framework.compiled import check_terms
     from .model.framework.units import normalized_slots, units
@@ -377,8 +397,10 @@ def _solve_real(fw, settings: Settings, tolerances: Tolerances, t: Timings) -> P
             if taut in sets:
                 check_terms(fw, fs, target)  # a degenerate equation: refused, not searched
     with t.stage("solve"):
-        found = search(land, SHORT, MIN_WIDTH, max_seconds=settings.timeout,
-                       label=f"real search of {fw.name}")  # fmt: skip
+        # Shared over local processes or a Dask cluster where asked (each rebuilds `land`).
+        found = split_search(landscape, fw, SHORT, MIN_WIDTH, workers=settings.workers or 1,
+                             scheduler=settings.scheduler, max_seconds=settings.timeout,
+                             label=f"real search of {fw.name}")  # fmt: skip
         # Critical points the search could not prove: in boxes left undecided (a continuum
         # passes there) or set aside next to a cone point (a saddle leaves the cone point as
         # the other elements' pull there passes k L0): found by Newton, not proved unique.
@@ -498,6 +520,8 @@ def real_search_info(found, length_unit: float, along: int = 0, morse_bott: bool
     return {
         "boxes": found.boxes,
         "seconds": round(found.seconds, 4),
+        "cpu_seconds": round(found.cpu_seconds, 4),
+        "shares": found.shares,
         "roots": len(found.roots),
         "set_aside": found.set_aside,
         "set_aside_longest_spring": found.set_aside_bound * length_unit,

@@ -60,8 +60,9 @@ class Settings:
     threads: int | None = None  # None: Bertini uses every core
     bertini: str | None = None  # path of a Bertini 1.x binary; None: the bundled bertini2
     extra_config: dict[str, str] = field(default_factory=dict)
-    # A Dask scheduler address: a generic set solved ab initio is split over its workers (where
-    # the paths are tracked, not what is found: not part of a result's key).
+    # A Dask scheduler address: a generic set solved ab initio is split over its workers, or
+    # the real route's boxes (where the work is done, not what is found: not part of a
+    # result's key).
     scheduler: str | None = None
     # How a generic set is found (backends/generic.py): "monodromy", "total-degree" or "both";
     # None: backends.generic.DEFAULT_ROUTE (monodromy; total-degree with a scheduler).
@@ -71,6 +72,9 @@ class Settings:
     # every taut set: generic sets and parameter homotopy); None: the real route where it covers
     # the configuration space, else the complex one.
     route: str | None = None
+    # Local processes that share the real route's boxes (None or 1: the search in this
+    # process); not part of a result's key. A sweep or map splits its points instead.
+    workers: int | None = None
 
     def __new__(cls, *args: object, **values: object) -> Settings:
         """Refuse an unknown setting with ParameterError (not a bare TypeError)."""
@@ -94,6 +98,13 @@ class Settings:
             raise ParameterError(f"timeout = {self.timeout!r}: must be > 0 seconds")
         if self.threads is not None and self.threads < 1:
             raise ParameterError(f"threads = {self.threads!r}: must be >= 1")
+        if self.workers is not None and self.workers < 1:
+            raise ParameterError(f"workers = {self.workers!r}: must be an integer >= 1")
+        if self.workers not in (None, 1) and self.scheduler is not None:
+            raise ParameterError(
+                f"workers = {self.workers!r} with scheduler = {self.scheduler!r}: the boxes go "
+                "to the scheduler's workers or to local processes; give one or the other"
+            )
         if self.variable_groups not in ("total_degree", "multihomogeneous"):
             raise ParameterError(
                 f"variable_groups = {self.variable_groups!r}: "
@@ -182,19 +193,20 @@ class Settings:
         """All settings, for run.json and cache keys (`scheduler` only when set, so that the
         sweep specs and keys written before it existed still match)."""
         out = asdict(self)
-        for name in ("scheduler", "generic", "route"):  # absent when unset: older keys match
+        for name in ("scheduler", "generic", "route", "workers"):  # unset: older keys match
             if out[name] is None:
                 del out[name]
         return out
 
     def result_key(self) -> dict:
-        """The settings a result depends on (not the time limit, thread count or scheduler)."""
-        skip = ("timeout", "threads", "scheduler", "generic")  # every route: the same set
+        """The settings a result depends on (not the time limit, threads, workers or
+        scheduler)."""
+        skip = ("timeout", "threads", "scheduler", "generic", "workers")  # the same set
         return {k: v for k, v in self.as_dict().items() if k not in skip}
 
 
 def _check_types(s: Settings) -> None:
-    ints = ("seed", "mptype", "precision", "security_level", "threads")
+    ints = ("seed", "mptype", "precision", "security_level", "threads", "workers")
     floats = ("final_tol", "tracktol_before_eg", "tracktol_during_eg", "condnum_threshold")
     for name in ints:
         value = getattr(s, name)

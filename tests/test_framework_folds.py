@@ -311,9 +311,9 @@ def test_cotm_relaxed_folds_against_plain_geometry_and_the_closed_form():
     the two angles is singular (plain numpy, central differences), each changes the stable
     count, and they lie on the closed form's relaxed family (catastrophe/paper_folds.py) and
     cover it in the window."""
+    from cotm_bertini.backends.pools import worker_pool
     from cotm_bertini.catastrophe import framework_folds as ff
     from cotm_bertini.catastrophe.paper_folds import fold_curves
-    from cotm_bertini.continuation.runner import worker_pool
     from cotm_bertini.model.framework.folds import RELAXED, curve_system
 
     fw = cb.Framework.from_toml(EXAMPLES / "cotm.toml")

@@ -231,7 +231,9 @@ def test_solve_with_scheduler_equals_solve_without(scheduler, tmp_path, monkeypa
     solved = {}
     # Without a scheduler the total-degree route asked for: the same start, in this process.
     plain_route = {"settings": cb.Settings(generic="total-degree")}
-    for name, options in (("split", {"scheduler": scheduler}), ("bertini", plain_route)):
+    # The complex route asked for: by default a scheduler shares the real route's boxes.
+    split_route = {"scheduler": scheduler, "route": "complex"}
+    for name, options in (("split", split_route), ("bertini", plain_route)):
         monkeypatch.setenv("COTM_CACHE", str(tmp_path / name))  # generic sets solved afresh
         monkeypatch.setattr(homotopy, "_LOADED", {})
         solved[name] = cb.solve(fw, cache=False, **options)
@@ -254,7 +256,7 @@ def test_solve_with_scheduler_equals_solve_without(scheduler, tmp_path, monkeypa
         assert len(cols) >= 4 and list(x["kind"]) == list(y["kind"])
         assert np.allclose(x[cols].to_numpy(float), y[cols].to_numpy(float), atol=1e-9, rtol=0)
     # Asked again with the sets in memory: nothing is solved, and the record says so.
-    again = cb.solve(fw, cache=False, scheduler=scheduler)
+    again = cb.solve(fw, cache=False, **split_route)
     route = again.record["details"]["taut_sets"]["none"]["generic_route"]
     assert not route["scheduler_used"] and "not needed" in route["note"]
 

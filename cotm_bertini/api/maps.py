@@ -103,7 +103,7 @@ def design_map(
     A framework: design_map(fw, "x", (-0.6, 0.8), "y", (-0.8, 0.2), points=101), any two of
     its parameters. The paper's mechanism: design_map(params, l01=(0, 14), l02=(0, 14),
     points=101) (or positionally design_map(params, (0, 14), (0, 14), 101))."""
-    from ..continuation.runner import check_workers
+    from ..backends.pools import check_workers
     from ..continuation.spec import check_grid
     from ..point import check_route
     from .sweeps import sweep
@@ -232,7 +232,7 @@ class _FoldsAside:
         import multiprocessing as mp
         from concurrent.futures import ProcessPoolExecutor
 
-        from ..continuation.runner import start_method
+        from ..backends.pools import start_method
 
         self.pool = ProcessPoolExecutor(max_workers=1, mp_context=mp.get_context(start_method()))
         self.future = self.pool.submit(_timed_folds, job)

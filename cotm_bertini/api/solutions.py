@@ -180,7 +180,8 @@ def solve(
 
     Options are Settings fields (seed, engine, mptype, final_tol, timeout, threads, ...), each
     honoured or refused with ParameterError; `scheduler="tcp://host:8786"` splits the paths of
-    a generic set solved ab initio over that Dask cluster's workers (docs/frameworks.md). An
+    a generic set solved ab initio over that Dask cluster's workers, or a framework's real
+    search (its boxes), which `workers=N` splits over N local processes (docs/frameworks.md). An
     identical earlier request is answered from the content-hash cache (`cache=False` solves
     again). A solver failure raises SolverError; its
     `folder` attribute holds what the solver left (input, output, failed attempts, run.json).

@@ -83,6 +83,8 @@ class BoxSearch:
     budget_hit: str = ""
     notes: list[str] = field(default_factory=list)
     volume: float = 0.0  # of the domain searched (0: the torus, (2 pi)^n)
+    cpu_seconds: float = 0.0  # in every process that searched (`seconds` is the wall time)
+    shares: int = 1  # the shares of boxes searched apart (backends.box_shares), merged here
 
     @property
     def undecided_share(self) -> float:
@@ -120,14 +122,12 @@ def search(
     """Decide every box of the domain (module docstring), or of `boxes` (lo, hi) where given
     (a share of it, for a worker); stop at `max_boxes` or `max_seconds` with the boxes not yet
     decided listed as undecided."""
-    t0 = time.perf_counter()
-    n = land.n
+    t0, c0 = time.perf_counter(), time.process_time()
     first = boxes if boxes is not None else domain(land, start)
     volume = float(np.prod(first[1] - first[0], axis=1).sum())
     stack, deferred = [first], []
     roots, root_boxes, undecided = [], [], []
-    acc = {"boxes": 0, "aside": 0, "bound": 0.0, "shortest": math.inf, "failed": 0,
-           "aside_boxes": []}  # fmt: skip
+    acc = _tally()
     pending, budget = 1.0, ""
     report = Progress(label, 1.0, "of the poses decided")
     while stack or deferred:
@@ -161,12 +161,93 @@ def search(
         pending -= share
         report.set(1.0 - pending, note=f"{acc['boxes']:,} boxes")
     report.close()
-    undec = _rows(undecided, n)
+    return _record(land.n, acc, (roots, root_boxes, undecided), (t0, c0), budget, volume)
+
+
+def spread(
+    land: BoxLandscape, first: tuple[np.ndarray, np.ndarray], short: float, min_width: float,
+    want: int, steps: int,
+) -> tuple[tuple[np.ndarray, np.ndarray], BoxSearch]:  # fmt: skip
+    """Breadth-first batch steps over the boxes `first` (lo, hi) until at least `want` are
+    left to decide, or for at most `steps`: (the boxes left, what the steps decided, over the
+    volume of `first`). Their fate is what `search` gives them: a box's is its own."""
+    t0, c0 = time.perf_counter(), time.process_time()
+    volume = float(np.prod(first[1] - first[0], axis=1).sum())
+    (lo, hi), acc, found = first, _tally(), ([], [], [])
+    for _ in range(steps):
+        if not len(lo) or len(lo) >= want:
+            break
+        acc["boxes"] += len(lo)
+        (lo, hi), (roots, root_boxes), left, _ = _step(land, lo, hi, short, min_width, acc, True)
+        found[0].extend(roots)
+        found[1].extend(root_boxes)
+        if len(left):
+            found[2].append(left)
+    return (lo, hi), _record(land.n, acc, found, (t0, c0), "", volume)
+
+
+def _tally() -> dict:
+    """What a search counts as it goes (`_step` adds to it)."""
+    return {"boxes": 0, "aside": 0, "bound": 0.0, "shortest": math.inf, "failed": 0,
+            "aside_boxes": []}  # fmt: skip
+
+
+def _record(n: int, acc: dict, found: tuple, clocks: tuple, budget: str, volume: float):
+    """A BoxSearch from the tally, (roots, their boxes, undecided parts), the wall and CPU
+    clocks at the start."""
+    roots, root_boxes, undecided = found
     return BoxSearch(
         np.array(roots).reshape(-1, n), np.array(root_boxes).reshape(-1, 2 * n), acc["failed"],
-        acc["aside"], acc["bound"], _rows(acc["aside_boxes"], n), undec, acc["boxes"],
-        time.perf_counter() - t0, acc["shortest"], budget, volume=volume,
+        acc["aside"], acc["bound"], _rows(acc["aside_boxes"], n), _rows(undecided, n),
+        acc["boxes"], time.perf_counter() - clocks[0], acc["shortest"], budget, volume=volume,
+        cpu_seconds=time.process_time() - clocks[1],
     )  # fmt: skip
+
+
+def merged(parts: list[BoxSearch], volume: float, seconds: float, apart: float = 1e-8):
+    """One record of searches over disjoint parts of a domain of `volume` (`seconds`: the wall
+    time of them all): counts summed, boxes listed together, the bounds combined, each root
+    once (two within `apart` rad of each other, angles taken modulo 2 pi, are one: a root on
+    the face two parts' boxes share)."""
+    n = parts[0].roots.shape[1]
+    roots = np.vstack([p.roots for p in parts])
+    keep = distinct(roots, apart)
+    keep = keep[_ordered(roots[keep])]
+    hits = [p.budget_hit for p in parts if p.budget_hit]
+    shares = sum(p.shares for p in parts)
+    notes = [x for p in parts for x in p.notes]
+    if len(keep) < len(roots):
+        notes.append(f"{len(roots) - len(keep)} roots proved in two shares' boxes kept once")
+    total = lambda name: sum(getattr(p, name) for p in parts)  # noqa: E731
+    boxes = lambda name: _rows([getattr(p, name) for p in parts], n)  # noqa: E731
+    return BoxSearch(
+        roots[keep], boxes("root_boxes")[keep], total("newton_failed"), total("set_aside"),
+        max(p.set_aside_bound for p in parts), boxes("set_aside_boxes"), boxes("undecided"),
+        total("boxes"), seconds, min(p.shortest_length for p in parts),
+        f"{len(hits)} of {shares} shares {hits[0]}" if hits else "", notes, volume,
+        total("cpu_seconds"), shares,
+    )  # fmt: skip
+
+
+def _ordered(roots: np.ndarray) -> np.ndarray:
+    """The roots' order by their angles (first, then second, ...): one order whichever shares
+    came back first (the search in one process keeps the order it found them in: fold seeds
+    follow it)."""
+    return np.lexsort(roots.T[::-1]) if len(roots) else np.zeros(0, dtype=np.int64)
+
+
+def distinct(points: np.ndarray, apart: float) -> np.ndarray:
+    """The indices of the points (R, n angles) not within `apart` rad (on the torus: angles
+    modulo 2 pi) of an earlier one."""
+    keep: list[int] = []
+    for i in range(len(points)):
+        if not keep:
+            keep.append(i)
+            continue
+        gap = np.abs((points[keep] - points[i] + math.pi) % TWO_PI - math.pi).max(axis=1)
+        if gap.min() > apart:
+            keep.append(i)
+    return np.array(keep, dtype=np.int64)
 
 
 def _rows(parts: list, n: int) -> np.ndarray:
@@ -174,12 +255,21 @@ def _rows(parts: list, n: int) -> np.ndarray:
 
 
 def _take(stack: list, count: int) -> tuple[np.ndarray, np.ndarray]:
-    """Up to `count` boxes from the top of the stack (depth first keeps it short)."""
-    lo, hi = stack.pop()
-    if len(lo) > count:
-        stack.append((lo[:-count], hi[:-count]))
-        lo, hi = lo[-count:], hi[-count:]
-    return lo, hi
+    """Up to `count` boxes from the top of the stack (depth first keeps it short), from as
+    many of its entries as it takes: a step of few boxes costs numpy's overhead all the same."""
+    los, his, have = [], [], 0
+    while stack and have < count:
+        lo, hi = stack.pop()
+        if have + len(lo) > count:
+            cut = len(lo) - (count - have)
+            stack.append((lo[:cut], hi[:cut]))
+            lo, hi = lo[cut:], hi[cut:]
+        los.append(lo)
+        his.append(hi)
+        have += len(lo)
+    if len(los) == 1:
+        return los[0], his[0]
+    return np.vstack(los), np.vstack(his)
 
 
 def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, acc: dict, testing: bool):

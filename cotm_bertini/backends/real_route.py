@@ -29,7 +29,7 @@ from ..model.framework.spec import Framework
 from ..model.framework.structure import layout
 from ..model.framework.units import normalized_slots
 from ..model.intervals import Interval, stack
-from .boxes import MIN_WIDTH, SHORT, BoxSearch, domain, search
+from .boxes import MIN_WIDTH, SHORT, BoxSearch, distinct, domain, search
 from .endpoints import Endpoints
 from .links import EITHER, SLACK, TAUT, columns, force_density, interval_sum, links
 from .spheres import SphereFramework
@@ -285,12 +285,17 @@ def descent_minima(land, starts: int, seed: int, steps: int = 200) -> np.ndarray
 def fresh_points(points: np.ndarray, known: np.ndarray, apart: float = 1e-8) -> np.ndarray:
     """The points (R, n angles) that are neither within `apart` (rad, on the torus) of a
     `known` one nor of an earlier one of their own."""
-    kept: list[np.ndarray] = []
-    for x in points:
-        others = list(known) + kept
-        if all(np.abs((x - y + np.pi) % (2 * np.pi) - np.pi).max() > apart for y in others):
-            kept.append(x)
-    return np.array(kept).reshape(-1, known.shape[1] if known.ndim == 2 else points.shape[1])
+    n = known.shape[1] if known.ndim == 2 else points.shape[1]
+    both = np.vstack([known.reshape(-1, n), points.reshape(-1, n)])
+    keep = distinct(both, apart)
+    return both[keep[keep >= len(known)]]
+
+
+@lru_cache(maxsize=8)
+def landscape(fw: Framework) -> TorusFramework:
+    """The torus landscape of `fw`, built once a process: a worker searching several shares of
+    its boxes (backends.box_shares) rebuilds it once, and the solve that dealt them not again."""
+    return TorusFramework(fw)
 
 
 @lru_cache(maxsize=128)

@@ -18,7 +18,7 @@ from functools import cache
 
 import numpy as np
 
-from ..continuation.runner import Run
+from ..backends.pools import Run
 from ..model.framework.compiled import framework_system, variable_groups
 from ..model.framework.folds import CurveSystem
 from ..model.framework.spec import Framework

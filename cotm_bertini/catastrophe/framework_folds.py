@@ -42,8 +42,8 @@ from ..analysis.framework_classify import (
 )
 from ..backends.endpoints import Endpoints
 from ..backends.homotopy import generic_set, track
+from ..backends.pools import Run, worker_pool
 from ..backends.start_system import bezout_number, fewest_paths_groups, group_degrees
-from ..continuation.runner import Run, worker_pool
 from ..errors import ParameterError
 from ..model.framework.compiled import framework_system
 from ..model.framework.folds import (

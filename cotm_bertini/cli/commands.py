@@ -42,6 +42,8 @@ def solve(args: argparse.Namespace) -> int:
     params, settings, label = params_from(args), settings_from(args), label_of(args)
     if getattr(args, "scheduler", None) is not None:  # `certify` has none
         settings = settings.replace(scheduler=args.scheduler)
+    if getattr(args, "workers", None) is not None:
+        settings = settings.replace(workers=args.workers)
     root = output_root(args.out) if args.out else Path("runs") / label
     output_root(root)
     try:
@@ -382,7 +384,7 @@ def plan(args: argparse.Namespace) -> int:
 
 def _workers(args: argparse.Namespace) -> int:
     """--workers, or one per core; refused below 1."""
-    from ..continuation.runner import default_workers
+    from ..backends.pools import default_workers
 
     workers = default_workers() if args.workers is None else args.workers
     if workers < 1:

@@ -51,7 +51,12 @@ def _solve_parser(sub) -> None:
         "--scheduler",
         metavar="ADDRESS",
         help="a Dask scheduler, tcp://host:8786: a generic set solved ab initio has its paths "
-        "split over the workers",
+        "split over the workers, a framework's real search its boxes",
+    )
+    s.add_argument(
+        "--workers",
+        type=int,
+        help="local processes that share a framework's real search (default 1: this process)",
     )
     s.add_argument(
         "--certify",

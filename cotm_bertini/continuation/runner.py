@@ -8,16 +8,18 @@ already stored. `sweep.csv` is assembled from the points at the end.
 
 from __future__ import annotations
 
-import contextlib
 import json
-import os
-import sys
 import time
 from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 
 import numpy as np
 
+from ..backends.pools import Run as Run
+from ..backends.pools import as_done, check_workers
+from ..backends.pools import default_workers as default_workers
+from ..backends.pools import start_method as start_method
+from ..backends.pools import worker_pool as worker_pool
 from ..errors import ParameterError
 from ..fs import write_json
 from ..params import Params
@@ -269,60 +271,8 @@ def _execute(
             yield from solve_run(spec, run, names)  # in process: point by point, with progress
         return
     tasks = [(run, spec.to_json(), names) for run in runs]
-    if scheduler is not None:
-        from ..backends.dask_jobs import run_jobs
-
-        for _, rows in run_jobs(_run_task, tasks, scheduler):
-            yield from rows
-        return
-    import multiprocessing as mp
-    from concurrent.futures import ProcessPoolExecutor, as_completed
-
-    ctx = mp.get_context(start_method())
-    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
-        for fut in as_completed([pool.submit(_run_task, t) for t in tasks]):
-            yield from fut.result()
-
-
-Run = Callable[[Callable, list], list]  # run(function, tasks) -> the results, in order
-
-
-@contextlib.contextmanager
-def worker_pool(workers: int) -> Iterator[Run]:
-    """A `Run` in this process (workers = 1) or in `workers` processes, started at the first
-    run as the sweeps' are (start_method: by then this process may have loaded the bertini
-    module, and must not fork); the tasks and the function must pickle."""
-    check_workers(workers)
-    if workers == 1:
-        yield lambda fn, tasks: [fn(t) for t in tasks]
-        return
-    import multiprocessing as mp
-    from concurrent.futures import ProcessPoolExecutor
-
-    pools: list[ProcessPoolExecutor] = []
-
-    def run(fn: Callable, tasks: list) -> list:
-        if not pools:
-            ctx = mp.get_context(start_method())
-            pools.append(ProcessPoolExecutor(max_workers=workers, mp_context=ctx))
-        return list(pools[0].map(fn, tasks))
-
-    try:
-        yield run
-    finally:
-        for pool in pools:
-            pool.shutdown()
-
-
-def start_method() -> str:
-    """How worker processes start: `fork` while this process has not loaded the bertini module
-    and runs no other thread (the workers then begin with numpy, this package and the generic
-    sets already loaded), else `spawn` (the bertini module is not fork-safe with its threads)."""
-    import threading
-
-    if sys.platform == "linux" and "bertini" not in sys.modules and threading.active_count() == 1:
-        return "fork"
-    return "spawn"
+    for _, rows in as_done(_run_task, tasks, workers, scheduler):
+        yield from rows
 
 
 def assemble_columns(spec: SweepSpec, folder: Path, store: PointStore | None = None) -> Columns:
@@ -338,16 +288,3 @@ def assemble_columns(spec: SweepSpec, folder: Path, store: PointStore | None = N
 def assemble(spec: SweepSpec, folder: Path, store: PointStore | None = None):
     """Every point's rows as one DataFrame, in grid order, with the dtypes of sweep.csv."""
     return to_frame(assemble_columns(spec, folder, store))
-
-
-def check_workers(workers: object) -> None:
-    """Refuse a worker count that is not an integer >= 1, naming the argument `workers`."""
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-        raise ParameterError(f"workers = {workers!r}: must be an integer >= 1")
-
-
-def default_workers() -> int:
-    """One worker per core."""
-    if hasattr(os, "sched_getaffinity"):
-        return max(1, len(os.sched_getaffinity(0)))
-    return max(1, os.cpu_count() or 1)

@@ -1,0 +1,117 @@
+"""The branch and bound of backends.boxes split over processes: local ones (`workers`) or a
+Dask cluster's (`scheduler`). Boxes are independent (a box's fate is its own), so the start
+boxes, after a few breadth-first steps where they are too few to balance, are dealt round-robin
+into shares (neighbouring boxes to different shares: each gets a similar mix of easy and hard
+ones), each searched by a worker that rebuilds the landscape from a picklable source
+(`factory(source)`: any BoxLandscape, the torus of a planar framework or the charts of a spatial
+one), and the records are merged into one (boxes.merged).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+from ..errors import SolverError
+from ..model.intervals import Interval
+from ..progress import Progress, silenced
+from .boxes import BATCH, BoxLandscape, BoxSearch, domain, merged, search, spread
+from .pools import as_done
+
+# A worker done early takes another share, and the progress moves a share at a time; but each
+# share walks its boxes down in as many batch steps as the whole search (about 1 ms of numpy's
+# overhead each): more than one share a worker only where the start boxes fill BATCH-box steps.
+SHARES_A_WORKER = 4
+BOXES_A_SHARE = 16  # breadth-first steps until there are this many boxes a share to deal
+SPREAD_STEPS = 8  # ... at most (a 1-D domain of 8 boxes: 16 a share after a few steps)
+
+
+def split_search(
+    factory: Callable[[object], BoxLandscape],
+    source: object,
+    short: float,
+    min_width: float,
+    *,
+    workers: int = 1,
+    scheduler: str | None = None,
+    start: int = 8,
+    max_boxes: int | None = None,
+    max_seconds: float | None = None,
+    label: str = "real search",
+) -> BoxSearch:
+    """boxes.search over the landscape `factory(source)`, its boxes shared among `workers`
+    local processes or the workers of the Dask cluster at `scheduler` (a single worker: the
+    plain search in this process); the budgets hold for the whole search. `factory` and
+    `source` must pickle (a module's function and a frozen spec)."""
+    land = factory(source)
+    if scheduler is None and workers == 1:
+        return search(land, short, min_width, start, max_boxes, max_seconds, label)
+    t0 = time.perf_counter()
+    first = domain(land, start)
+    _warm(land, first)
+    volume = float(np.prod(first[1] - first[0], axis=1).sum())
+    deadline = None if max_seconds is None else time.time() + max_seconds
+    dealt: dict = {}  # what the breadth-first steps decided here, and the shares dealt
+
+    def jobs(count: int) -> list[tuple]:
+        shares = max(1, count) * min(SHARES_A_WORKER, max(1, len(first[0]) // BATCH))
+        (lo, hi), done = spread(land, first, short, min_width, shares * BOXES_A_SHARE,
+                                SPREAD_STEPS)  # fmt: skip
+        dealt["head"] = dataclasses.replace(done, shares=0, volume=volume)
+        dealt["left"] = float(np.prod(hi - lo, axis=1).sum()) / volume
+        dealt["shares"] = min(shares, len(lo))
+        most = None if max_boxes is None else max(1, math.ceil(max_boxes / shares))
+        step = dealt["shares"]
+        return [(factory, source, lo[k::step], hi[k::step], short, min_width, most, deadline)
+                for k in range(step)]  # fmt: skip
+
+    finished = as_done(_search_share, jobs, workers, scheduler)  # local processes start now
+    parts: dict[int, BoxSearch] = {}
+    with Progress(label, 1.0, "of the poses decided", heartbeat=True) as report:
+        for k, part in finished:
+            parts[k] = part
+            boxes = dealt["head"].boxes + sum(p.boxes for p in parts.values())
+            decided = 1.0 - dealt["left"] + sum(p.volume for p in parts.values()) / volume
+            report.set(decided, note=f"{boxes:,} boxes, {len(parts)}/{dealt['shares']} shares")
+    found = [dealt["head"]] + [parts[k] for k in sorted(parts)]
+    _check_cover(label, dealt, parts, volume)
+    return merged(found, volume, time.perf_counter() - t0)
+
+
+def _check_cover(label: str, dealt: dict, parts: dict, volume: float) -> None:
+    """The steps here and the shares back cover the whole domain (every job comes back or
+    raises: a gap is a bug, never a smaller proof passed off as the whole)."""
+    covered = 1.0 - dealt["left"] + sum(p.volume for p in parts.values()) / volume
+    lost = sorted(set(range(dealt["shares"])) - set(parts))
+    if lost or abs(covered - 1.0) > 1e-9:
+        raise SolverError(
+            f"{label}: the shares searched cover {covered:.9g} of the domain, not all of it "
+            f"(shares {lost} of {dealt['shares']} never came back)"
+        )
+
+
+def _warm(land: BoxLandscape, first: tuple[np.ndarray, np.ndarray], most: int = 64) -> None:
+    """Every function of the landscape run once on a few boxes spread over the domain (cables
+    taut, slack and either: every taut set's Hessian), so that their generated code is
+    compiled before local workers fork from this process (each would compile it again)."""
+    pick = slice(None, None, max(1, len(first[0]) // most))
+    box = Interval(first[0][pick], first[1][pick])
+    _, _, states = land.enclose(box)
+    land.hessian(box, states)
+    land.derivatives(box.mid)
+
+
+def _search_share(job: tuple) -> BoxSearch:
+    """One share of boxes searched in a worker: the landscape rebuilt from its source (once a
+    process where the factory keeps it), its CPU time counted with the search's."""
+    factory, source, lo, hi, short, min_width, most, deadline = job
+    c0 = time.process_time()
+    with silenced():  # the parent reports the merged progress
+        land = factory(source)
+        left = None if deadline is None else max(deadline - time.time(), 1e-9)
+        found = search(land, short, min_width, max_boxes=most, max_seconds=left, boxes=(lo, hi))
+    return dataclasses.replace(found, cpu_seconds=time.process_time() - c0)

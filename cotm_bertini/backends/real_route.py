@@ -45,8 +45,11 @@ def covers(fw: Framework) -> str:
     return ""
 
 
+@lru_cache(maxsize=8)
 def landscape(fw: Framework) -> TorusFramework | SphereFramework:
-    """V over boxes of the framework's configuration space (covers says which)."""
+    """V over boxes of the framework's configuration space (covers says which), built once a
+    process: a worker searching several shares of its boxes (backends.box_shares) rebuilds it
+    once, and the solve that dealt them not again."""
     return SphereFramework(fw) if fw.dim == 3 else TorusFramework(fw)
 
 
@@ -289,13 +292,6 @@ def fresh_points(points: np.ndarray, known: np.ndarray, apart: float = 1e-8) -> 
     both = np.vstack([known.reshape(-1, n), points.reshape(-1, n)])
     keep = distinct(both, apart)
     return both[keep[keep >= len(known)]]
-
-
-@lru_cache(maxsize=8)
-def landscape(fw: Framework) -> TorusFramework:
-    """The torus landscape of `fw`, built once a process: a worker searching several shares of
-    its boxes (backends.box_shares) rebuilds it once, and the solve that dealt them not again."""
-    return TorusFramework(fw)
 
 
 @lru_cache(maxsize=128)

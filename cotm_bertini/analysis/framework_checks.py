@@ -145,13 +145,17 @@ def configuration_space(fw: Framework) -> tuple[list[str], str]:
     if lay.translations or lay.closing_pins:
         return [], "a body is not pinned to the ground or a pin closes a loop"
     factors = ["S1" if fw.dim == 2 else "SO3" for _ in lay.rotations]
-    hung = []
-    for bar in fw.bars:
-        ends = [p for p in (bar.a, bar.b) if p in lay.free_nodes]
-        if len(ends) != 1 or bar.a in lay.free_nodes and bar.b in lay.free_nodes:
-            return [], f"bar {bar.name} closes a loop"
-        hung.append(ends[0])
-    if sorted(hung) != sorted(lay.free_nodes):
+    # Free nodes hang by bars, one each, from a placed point or from a node hung before them
+    # (a two-stage tower): a sphere (circle) each about a point that moves with the ones above.
+    free, hung, left = set(lay.free_nodes), set(), list(fw.bars)
+    while left:
+        bar = next((b for b in left for top, node in ((b.a, b.b), (b.b, b.a))
+                    if node in free - hung and (top not in free or top in hung)), None)  # fmt: skip
+        if bar is None:
+            return [], f"bar {left[0].name} closes a loop"
+        hung |= {p for p in (bar.a, bar.b) if p in free}
+        left.remove(bar)
+    if hung != free:
         return [], "a node is not hung from a placed point by exactly one bar"
     factors += ["S1" if fw.dim == 2 else "S2" for _ in hung]
     return factors, ""

@@ -3,8 +3,10 @@ command line (a fresh cache: equations derived, then the branch and bound over c
 within a time budget, with what its run.json says: the search's boxes, the share of the
 configuration space left undecided, rows, stable ones, the Morse sum against the Euler
 characteristic 2^nodes, the status. Usage: python bench/spatial_route.py [--only NAME ...]
-[--workers N] [--budget NAME=SECONDS ...] (defaults: prism_slack 600 s, prism4 900 s, tower
-600 s; a solve stopped by its budget is `incomplete` and says how much is left)."""
+[--workers N | --dask N] [--budget NAME=SECONDS ...] (defaults: prism_slack 600 s, prism4
+900 s, tower 600 s; a solve stopped by its budget is `incomplete` and says how much is left;
+--dask N starts a local Dask cluster of N one-thread worker processes and solves on it with
+--scheduler: boxes a second against N, the scale-out a cluster of machines would give)."""
 
 from __future__ import annotations
 
@@ -24,14 +26,25 @@ ROOT = BENCH.parent
 BUDGETS = {"prism_slack": 600.0, "prism4": 900.0, "tower": 600.0}
 
 
-def _solve(name: str, budget: float, workers: int) -> dict:
+def _solve(name: str, budget: float, workers: int, scheduler: str = "") -> dict:
     """One first solve (fresh cache) on the command line and its run.json's figures."""
     cli = str(Path(sys.executable).with_name("cotm-bertini"))
     out = Path(tempfile.mkdtemp(prefix="cotm-bench-spatial-"))
     env = {**os.environ, "COTM_CACHE": str(out / "cache")}
-    args = [cli, "solve", "--framework", str(ROOT / "examples" / f"{name}.toml"), "--timeout",
-            str(budget), "--workers", str(workers), "--out", str(out / "runs"), "--no-cache",
-            "--no-plots", "--quiet"]  # fmt: skip
+    args = [
+        cli,
+        "solve",
+        "--framework",
+        str(ROOT / "examples" / f"{name}.toml"),
+        "--timeout",
+        str(budget),
+        "--out",
+        str(out / "runs"),
+        "--no-cache",
+        "--no-plots",
+        "--quiet",
+    ]
+    args += ["--scheduler", scheduler] if scheduler else ["--workers", str(workers)]
     t0 = time.perf_counter()
     done = subprocess.run(args, env=env, capture_output=True, text=True)
     wall = time.perf_counter() - t0
@@ -43,6 +56,7 @@ def _solve(name: str, budget: float, workers: int) -> dict:
         "example": name,
         "space": morse.get("manifold", ""),
         "workers": workers,
+        "dask": bool(scheduler),
         "budget_s": budget,
         "first_solve_s": wall,
         "search_s": search["seconds"],
@@ -62,6 +76,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--only", nargs="*", default=list(BUDGETS), choices=list(BUDGETS))
     ap.add_argument("--workers", type=int, default=1)
+    ap.add_argument("--dask", type=int, default=0, metavar="N")
     ap.add_argument("--budget", nargs="*", default=[], metavar="NAME=SECONDS")
     args = ap.parse_args()
     budgets = dict(BUDGETS)
@@ -70,11 +85,21 @@ def main() -> None:
         if name not in budgets:
             raise SystemExit(f"--budget: unknown example {name!r}")
         budgets[name] = float(seconds)
-    frame = pd.DataFrame([_solve(n, budgets[n], args.workers) for n in args.only])
+    if args.dask:
+        from distributed import LocalCluster
+
+        with LocalCluster(n_workers=args.dask, threads_per_worker=1, processes=True,
+                          dashboard_address=":0") as cluster:  # fmt: skip
+            rows = [_solve(n, budgets[n], args.dask, cluster.scheduler_address)
+                    for n in args.only]  # fmt: skip
+    else:
+        rows = [_solve(n, budgets[n], args.workers) for n in args.only]
+    frame = pd.DataFrame(rows)
     show("the real route on products of spheres: first solve within a budget", frame,
          {"first_solve_s": ".1f", "search_s": ".1f", "boxes_per_s": ".0f",
           "undecided_share": ".3g"})  # fmt: skip
-    write_csv(frame, "spatial_route" + (f"_w{args.workers}" if args.workers > 1 else ""))
+    tag = f"_dask{args.dask}" if args.dask else (f"_w{args.workers}" if args.workers > 1 else "")
+    write_csv(frame, "spatial_route" + tag)
 
 
 if __name__ == "__main__":

@@ -83,3 +83,21 @@ def same_sets(a: np.ndarray, b: np.ndarray, tol: float = 1e-8) -> bool:
             return False
         left.pop(int(np.argmin(gaps)))
     return True
+
+
+def lose_first_root(monkeypatch) -> list:
+    """Sabotage the real route: its search drops the first root it proves (returned in the
+    list, once it has): the checks downstream must see the hole."""
+    from cotm_bertini.backends import boxes
+
+    real_roots, dropped = boxes._roots, []
+
+    def lossy(land, lo, hi, k_lo, k_hi, acc, steps=40):
+        roots, found = real_roots(land, lo, hi, k_lo, k_hi, acc, steps)
+        if roots and not dropped:
+            dropped.append(roots[0])
+            return roots[1:], found[1:]
+        return roots, found
+
+    monkeypatch.setattr(boxes, "_roots", lossy)
+    return dropped

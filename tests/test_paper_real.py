@@ -9,7 +9,7 @@ import json
 
 import numpy as np
 import pytest
-from conftest import ROOT, run_cli
+from conftest import ROOT, lose_first_root, run_cli
 from paper_tables import K_RATIO, TABLE2, TABLE3, TABLE4, match_rows, unit
 from physics import angle_distance, balance, energy, mp_refine
 
@@ -135,18 +135,7 @@ def test_an_undecided_search_is_incomplete(tmp_path):
 def test_a_lost_root_is_caught_by_the_papers_morse_count(monkeypatch):
     """Sabotage: the search drops the first root it proves; the paper's Morse count on the
     torus (zero-length cusps in closed form, not the search's) sees the hole."""
-    from cotm_bertini.backends import boxes
-
-    real_roots, dropped = boxes._roots, []
-
-    def lossy(land, lo, hi, k_lo, k_hi, acc, steps=40):
-        roots, found = real_roots(land, lo, hi, k_lo, k_hi, acc, steps)
-        if roots and not dropped:
-            dropped.append(roots[0])
-            return roots[1:], found[1:]
-        return roots, found
-
-    monkeypatch.setattr(boxes, "_roots", lossy)
+    dropped = lose_first_root(monkeypatch)
     res = _real(cb.Params.case("case1"))
     assert dropped and len(res.physical) == 3 and res.status == "incomplete"
     assert any("#min - #saddle + #max" in w for w in res.warnings)

@@ -12,7 +12,7 @@ import sys
 import mpmath
 import numpy as np
 import pytest
-from conftest import ROOT
+from conftest import ROOT, lose_first_root
 
 import cotm_bertini as cb
 from cotm_bertini.model.intervals import Interval
@@ -254,19 +254,7 @@ def test_a_search_stopped_early_is_incomplete_never_ok(tmp_path):
 def test_a_lost_root_is_caught_by_the_morse_count(monkeypatch):
     """Sabotage: the search drops the first root it proves; the Morse count on the torus sees
     the hole and the status says equilibria may be missing."""
-    from cotm_bertini.backends import boxes
-
-    real_roots = boxes._roots
-    dropped = []
-
-    def lossy(land, lo, hi, k_lo, k_hi, acc, steps=40):
-        roots, found = real_roots(land, lo, hi, k_lo, k_hi, acc, steps)
-        if roots and not dropped:
-            dropped.append(roots[0])
-            return roots[1:], found[1:]
-        return roots, found
-
-    monkeypatch.setattr(boxes, "_roots", lossy)
+    dropped = lose_first_root(monkeypatch)
     res = cb.solve(cb.Framework.from_toml(XMODULE), route="real", cache=False)
     assert dropped and len(res.physical) == 11
     assert res.status == "incomplete"

@@ -11,6 +11,7 @@ import numpy as np
 from ..model.framework.spec import Framework
 from ..model.framework.units import normalized_slots
 from ..model.intervals import Interval
+from .endpoints import Endpoints
 
 TAUT, SLACK, EITHER = 1, 0, 2
 
@@ -67,3 +68,15 @@ def interval_sum(items) -> Interval:
     for v in items:
         out = Interval.of(v) if out is None else out + v
     return out
+
+
+def found_endpoints(variables, values: np.ndarray, rows) -> Endpoints:
+    """Critical points the real route found as endpoints of a taut set's system: the values
+    (R, variables) and each one's number; no path, so no path data (NaN)."""
+    count = len(values)
+    nan = np.full(count, np.nan)
+    return Endpoints(
+        tuple(variables), values, np.asarray(rows, dtype=np.int64), nan, nan, nan,
+        np.zeros(count), nan, nan, nan, np.ones(count, dtype=np.int64),
+        np.zeros(count, dtype=bool),
+    )  # fmt: skip

@@ -31,7 +31,16 @@ from ..model.framework.units import normalized_slots
 from ..model.intervals import Interval, stack
 from .boxes import MIN_WIDTH, SHORT, BoxSearch, distinct, domain, search
 from .endpoints import Endpoints
-from .links import EITHER, SLACK, TAUT, columns, force_density, interval_sum, links
+from .links import (
+    EITHER,
+    SLACK,
+    TAUT,
+    columns,
+    force_density,
+    found_endpoints,
+    interval_sum,
+    links,
+)
 from .spheres import SphereFramework
 
 
@@ -226,13 +235,7 @@ class TorusFramework:
                 values[:, k] = x.k * (1.0 - x.L0 / d[rest][rows])
             else:
                 raise ValueError(f"the real route has no value for unknown {v}")
-        count = len(rows)
-        nan = np.full(count, np.nan)
-        return Endpoints(
-            tuple(fs.ps.variables), values, np.asarray(rows, dtype=np.int64), nan, nan, nan,
-            np.zeros(count), nan, nan, nan, np.ones(count, dtype=np.int64),
-            np.zeros(count, dtype=bool),
-        )  # fmt: skip
+        return found_endpoints(fs.ps.variables, values, rows)
 
 
 def critical_seeds(land: TorusFramework, boxes: np.ndarray, most: int = 32) -> np.ndarray:

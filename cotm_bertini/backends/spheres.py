@@ -36,7 +36,7 @@ from ..model.framework.units import normalized_slots
 from ..model.intervals import Interval, stack
 from .boxes import OFFSET
 from .endpoints import Endpoints
-from .links import SLACK, TAUT, columns, force_density, interval_sum, links
+from .links import SLACK, TAUT, columns, force_density, found_endpoints, interval_sum, links
 
 SHIFT = 8.0  # chart B's first angle is stored as a + SHIFT
 BAND = 0.6107  # chart A covers a in [BAND + TILT, pi - BAND + TILT]
@@ -249,6 +249,24 @@ class SphereFramework:
         """grad V and its Hessian at points (R, n chart angles) in double precision (each
         point's Hessian that of its taut set: slack cables' stiffness 0)."""
         count = len(x)
+        g, X, P, dirs = self._numeric(x)
+        m = X.shape[1]
+        full = np.zeros((count, len(self.full.ps.variables)))
+        full[:, self.coords] = X
+        H = columns(self.full.numeric.hessian(full, P), count).reshape(count, m, m)
+        J = np.stack([np.stack(row, axis=1) for row in self.jacobian(dirs, count)], axis=1)
+        hess = np.einsum("nia,nij,njb->nab", J, H, J)
+        for i, v in enumerate(self.nodes):
+            G = self.pull(list(g.T), v)
+            for (p, q), key in SECOND:
+                hess[:, 2 * i + p, 2 * i + q] += self.length[v] * _dot(dirs[i][key], G)
+        return np.einsum("nia,ni->na", J, g), hess
+
+    def _numeric(self, x: np.ndarray) -> tuple:
+        """At points (R, n chart angles): grad V in node coordinates, the node coordinates,
+        the parameters with each slack cable's stiffness 0 (its taut set's Hessian), and the
+        directions with their derivatives."""
+        count = len(x)
         positions, dirs = self.kinematics(x)
         X = np.zeros((count, len(self.full.ps.variables)))
         X[:, self.coords] = np.stack(positions, axis=1)
@@ -265,14 +283,7 @@ class SphereFramework:
                 P[:, self.k_slots[link.name]] *= d > link.L0
                 w = np.where(d > link.L0, w, 0.0)
             g += w[:, None] * np.einsum("nc,ncj->nj", r, dr)
-        H = columns(self.full.numeric.hessian(X, P), count).reshape(count, m, m)
-        J = np.stack([np.stack(row, axis=1) for row in self.jacobian(dirs, count)], axis=1)
-        hess = np.einsum("nia,nij,njb->nab", J, H, J)
-        for i, v in enumerate(self.nodes):
-            G = self.pull(list(g.T), v)
-            for (p, q), key in SECOND:
-                hess[:, 2 * i + p, 2 * i + q] += self.length[v] * _dot(dirs[i][key], G)
-        return np.einsum("nia,ni->na", J, g), hess
+        return g, X[:, self.coords], P, dirs
 
     def positions(self, x: np.ndarray) -> np.ndarray:
         """Node coordinates (R, 3 per node) at points (R, n chart angles)."""
@@ -315,7 +326,7 @@ class SphereFramework:
             x = next((y for y in self.links if y.name == c), None)
             if x is not None and x.L0 is not None:
                 taut[:, j] = d[c] >= x.L0
-        grad, _ = self.derivatives_in_nodes(roots)
+        grad = self._numeric(roots)[0]
         out = {}
         for key in {tuple(row) for row in taut}:
             rows = np.flatnonzero((taut == np.array(key)).all(axis=1))
@@ -324,25 +335,6 @@ class SphereFramework:
             out[names] = self._endpoints(fs, X[rows], {k: v[rows] for k, v in d.items()},
                                          grad[rows])  # fmt: skip
         return out
-
-    def derivatives_in_nodes(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """grad V in node coordinates at points (R, n chart angles), and the positions."""
-        count = len(x)
-        positions, _ = self.kinematics(x)
-        X = np.zeros((count, len(self.full.ps.variables)))
-        X[:, self.coords] = np.stack(positions, axis=1)
-        first = self.full.numeric.first_order(X, np.asarray(self.P))
-        m, per = len(positions), 3 + 3 * len(positions)
-        g = columns(first[len(self.links) * per :], count)
-        for i, link in enumerate(self.links):
-            block = columns(first[i * per : (i + 1) * per], count)
-            r, dr = block[:, :3], block[:, 3:].reshape(count, 3, m)
-            d = np.sqrt((r * r).sum(axis=1))
-            w = np.full(count, link.k) if link.L0 is None else link.k * (1 - link.L0 / d)
-            if link.cable and link.L0 is not None:
-                w = np.where(d > link.L0, w, 0.0)
-            g += w[:, None] * np.einsum("nc,ncj->nj", r, dr)
-        return g, X[:, self.coords]
 
     def _lengths(self, X: np.ndarray) -> dict[str, np.ndarray]:
         """Each spring's and cable's length at poses X (R, node coordinates)."""
@@ -392,13 +384,7 @@ class SphereFramework:
                 values[:, k] = mu[:, bars[rest]]
             else:
                 raise ValueError(f"the real route has no value for unknown {v}")
-        count = len(X)
-        nan = np.full(count, np.nan)
-        return Endpoints(
-            tuple(fs.ps.variables), values, np.arange(count, dtype=np.int64), nan, nan, nan,
-            np.zeros(count), nan, nan, nan, np.ones(count, dtype=np.int64),
-            np.zeros(count, dtype=bool),
-        )  # fmt: skip
+        return found_endpoints(fs.ps.variables, values, np.arange(len(X)))
 
 
 def _dot(u: list, v: list):

@@ -215,3 +215,38 @@ def test_a_zero_free_length_prism_real_and_complex_routes_agree(name):
     assert a.shape == b.shape
     gap = np.abs(a[:, None, :] - b[None]).max(axis=2)
     assert gap.min(axis=1).max() < 1e-8 and gap.min(axis=0).max() < 1e-8
+
+
+def _every_row_a_reference_point(res, name: str) -> int:
+    """How many of the result's physical rows are reference critical points (to 1e-7): all of
+    them, or the test fails."""
+    fw = spatial(name)
+    X = res.physical[[f"{n}.{c}" for n in fw.free for c in "xyz"]].to_numpy(float)
+    R = np.array([p["X"] for p in reference(name)[0]])
+    gap = np.abs(X[:, None, :] - R[None]).max(axis=2).min(axis=1)
+    assert (gap < 1e-7).all(), gap.max()
+    return len(X)
+
+
+@pytest.mark.slow
+def test_prism4_by_the_real_route_on_two_workers_equals_the_reference():
+    """`make stress`: the four-strut prism (8 dimensions, some 380 million boxes: about 16
+    minutes of one core, so two workers) proved, its 16 equilibria the reference's."""
+    fw = cb.Framework.from_toml(ROOT / "examples" / "prism4.toml")
+    res = cb.solve(fw, cache=False, workers=2)
+    assert res.status == "ok", res.warnings
+    ref, _ = reference("prism4")
+    _rows_against(res, ref, spatial("prism4").free, [c.name for c in fw.cables])
+
+
+@pytest.mark.slow
+def test_the_tower_within_a_budget_is_incomplete_and_every_row_is_the_references():
+    """`make stress`: the two-stage tower (12 dimensions) within 120 s: incomplete, the share
+    left undecided stated, and every row it found (by Newton from the boxes left, descents)
+    one of the reference's 108, the stable one among them."""
+    fw = cb.Framework.from_toml(ROOT / "examples" / "tower.toml")
+    res = cb.solve(fw, cache=False, timeout=120)
+    assert res.status == "incomplete"
+    assert res.record["details"]["real_search"]["undecided_share"] > 0.5
+    assert _every_row_a_reference_point(res, "tower") > 10
+    assert int(res.counts["stable"]) == 1

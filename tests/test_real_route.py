@@ -438,3 +438,33 @@ def test_the_maps_folds_and_switches_against_the_independent_energy(xmodule_map)
                 H = np.stack([(_x_energy(t + h * e, **values)[1] - _x_energy(t - h * e,
                               **values)[1])[0] / (2 * h) for e in np.eye(2)])  # fmt: skip
                 assert abs(np.linalg.det(H)) < 1e-5 * np.abs(H).max() ** 2 + 1e-7
+
+
+def test_a_seed_lines_branches_are_traced_once_for_a_taut_sets_curve_systems():
+    """The sweep route's branches along a seed line depend on the taut set's equilibria, not on
+    the curve system: a switch system given the fold system's branches finds the seeds (and
+    line records) it finds tracing its own; another taut set's lines never share them."""
+    from cotm_bertini.catastrophe.curve_trace import Window
+    from cotm_bertini.catastrophe.fold_sweep import branch_key, sweep_seeds
+    from cotm_bertini.catastrophe.framework_folds import _line_specs
+    from cotm_bertini.model.framework.folds import curve_system
+
+    fw = cb.Framework.from_toml(ROOT / "examples" / "zeeman_cables.toml")
+    both, one = ("band_p", "band_u"), ("band_p",)
+    fold, switch = (curve_system(fw, both, "x", "y", c) for c in ("", "band_u"))
+    sx, sy = fold.scales
+    n = len(fold.variables)
+    win = Window(n, n + 1, (-0.6 / sx, -0.8 / sy), (0.8 / sx, 0.2 / sy), (sx, sy))
+    specs = [_line_specs(win)[k] for k in (0, 4, 8, 9, 13, 17)]  # edges and middles
+    args = (("x", "y"), cb.Settings(), lambda fn, tasks: [fn(t) for t in tasks])
+    shared: dict = {}
+    sweep_seeds(fw, fold, specs, *args, branches=shared)
+    assert len(shared) == len(specs)
+    got = sweep_seeds(fw, switch, specs, *args, branches=shared)
+    alone = sweep_seeds(fw, switch, specs, *args, branches={})
+    assert len(shared) == len(specs)  # every line's branches were the fold system's
+    assert len(got[0]) == len(alone[0]) > 0 and got[1] == alone[1]
+    np.testing.assert_array_equal(np.array(got[0]), np.array(alone[0]))
+    other = curve_system(fw, one, "x", "y", "band_p")
+    ts = np.linspace(0.0, 1.0, 3)
+    assert branch_key(other, specs[0], ts, []) != branch_key(switch, specs[0], ts, [])

@@ -252,20 +252,9 @@ def solve_framework_point(
     taut set from that point by Newton (backends.target.solve_parameters)."""
     from .analysis.framework_checks import completeness, framework_counts, order_rows
     from .analysis.framework_continua import absorb, continuum_record, find_continua
-    from .model.framework.compiled import framework_system
-    from .model.framework.structure import check_mobility
     from .model.framework.units import normalized_slots, units
 
-    if settings.engine != "homotopy":
-        raise ParameterError(
-            f"engine = {settings.engine!r}: a framework is solved by the in-process homotopy "
-            "engine (engine='homotopy')"
-        )
-    check_route(fw, settings)
-    t = Timings()
-    with t.stage("derive"):
-        # Free even with every cable taut: a continuum of equilibria, refused as bad input.
-        check_mobility(fw, framework_system(fw, tuple(c.name for c in fw.cables)))
+    t = _framework_checks(fw, settings)
     if framework_route(fw, settings) == "real":
         return _solve_real(fw, settings, tolerances, t)
     unit = units(fw)
@@ -299,6 +288,45 @@ def solve_framework_point(
         engine, shape, {"taut_sets": report}, "\n".join(texts), t.stages, starts,
         tuple(continuum_record(c, n) for n, c in enumerate(continua, start=1)),
     )  # fmt: skip
+
+
+def _framework_checks(fw, settings: Settings) -> Timings:
+    """Refuse what no route of a framework solves (ParameterError); the timings begun."""
+    from .model.framework.compiled import framework_system
+    from .model.framework.structure import check_mobility
+
+    if settings.engine != "homotopy":
+        raise ParameterError(
+            f"engine = {settings.engine!r}: a framework is solved by the in-process homotopy "
+            "engine (engine='homotopy')"
+        )
+    check_route(fw, settings)
+    t = Timings()
+    with t.stage("derive"):
+        # Free even with every cable taut: a continuum of equilibria, refused as bad input.
+        check_mobility(fw, framework_system(fw, tuple(c.name for c in fw.cables)))
+    return t
+
+
+def solve_framework_points(
+    fws: list, settings: Settings = Settings(), tolerances: Tolerances = Tolerances()
+) -> list[PointSolution]:
+    """solve_framework_point at each of several values of one framework (a sweep's points).
+    On the real route their searches run together, in the same batches of boxes
+    (backends.real_route.search_frameworks): each point keeps its own search, box for box
+    the one it would have alone; every point is checked before any is searched."""
+    from .backends.real_route import search_frameworks
+
+    if not fws or framework_route(fws[0], settings) != "real":
+        return [solve_framework_point(fw, settings, tolerances) for fw in fws]
+    timings = [_framework_checks(fw, settings) for fw in fws]
+    ready = [_real_landscape(fw, t) for fw, t in zip(fws, timings, strict=True)]
+    found = search_frameworks(fws, settings.timeout, [land for land, _, _ in ready])
+    out = []
+    for fw, t, r, f in zip(fws, timings, ready, found, strict=True):
+        t.stages["solve"] = f.seconds  # this point's share of the batches' time
+        out.append(_solve_real(fw, settings, tolerances, t, r, f))
+    return out
 
 
 def check_route(model, settings: Settings, what: str = "solve") -> None:
@@ -374,21 +402,13 @@ SEEDS_AT_BUDGET = 512  # Newton starts in the boxes a search stopped by its budg
 DESCENTS = 64  # local descents from random poses when a search is stopped by its budget
 
 
-def _solve_real(fw, settings: Settings, tolerances: Tolerances, t: Timings) -> PointSolution:
-    """Every real equilibrium of a framework on a circle or torus, by the branch and bound of
-    backends.boxes over its body angles (backends.real_route), classified as the complex route's
-    endpoints are; the search's proof (or what it left undecided) is the completeness check.
-    Boxes left undecided are searched for continua of equilibria (where V is constant along a
-    curve no box can be decided), traced and counted apart as on the complex route."""
-    from .analysis.framework_checks import completeness, framework_counts, order_rows
-    from .analysis.framework_continua import absorb, continuum_record, find_continua
-    from .backends.box_shares import split_search
-    from .backends.boxes import SHORT
-    from .backends.real_route import critical_seeds, landscape
+def _real_landscape(fw, t: Timings) -> tuple:
+    """(the real route's landscape of `fw`, its taut sets, those pruned), every taut set's
+    equations derived and checked."""
+    from .backends.real_route import landscape
     from .model.framework.compiled import check_terms
-    from .model.framework.units import normalized_slots, units
+    from .model.framework.units import normalized_slots
 
-    unit = units(fw)
     sets, pruned = split_taut_sets(fw)
     with t.stage("derive"):
         land = landscape(fw)
@@ -396,11 +416,32 @@ def _solve_real(fw, settings: Settings, tolerances: Tolerances, t: Timings) -> P
         for taut, fs in land.hessian_sets:  # derived (or loaded) here, not in the search's clock
             if taut in sets:
                 check_terms(fw, fs, target)  # a degenerate equation: refused, not searched
+    return land, sets, pruned
+
+
+def _solve_real(
+    fw, settings: Settings, tolerances: Tolerances, t: Timings, ready=None, found=None
+) -> PointSolution:
+    """Every real equilibrium of a framework on a circle or torus, by the branch and bound of
+    backends.boxes over its body angles (backends.real_route), classified as the complex route's
+    endpoints are; the search's proof (or what it left undecided) is the completeness check.
+    Boxes left undecided are searched for continua of equilibria (where V is constant along a
+    curve no box can be decided), traced and counted apart as on the complex route. `ready`
+    and `found`: the landscape (_real_landscape) and its search, where already made."""
+    from .analysis.framework_checks import completeness, framework_counts, order_rows
+    from .analysis.framework_continua import absorb, continuum_record, find_continua
+    from .backends.box_shares import split_search
+    from .backends.boxes import SHORT
+    from .backends.real_route import critical_seeds, landscape
+    from .model.framework.units import units
+
+    unit = units(fw)
+    land, sets, pruned = ready or _real_landscape(fw, t)
     with t.stage("solve"):
-        # Shared over local processes or a Dask cluster where asked (each rebuilds `land`).
-        found = split_search(landscape, fw, SHORT, MIN_WIDTH, workers=settings.workers or 1,
-                             scheduler=settings.scheduler, max_seconds=settings.timeout,
-                             label=f"real search of {fw.name}")  # fmt: skip
+        if found is None:  # shared over local processes or a Dask cluster where asked
+            found = split_search(landscape, fw, SHORT, MIN_WIDTH, workers=settings.workers or 1,
+                                 scheduler=settings.scheduler, max_seconds=settings.timeout,
+                                 label=f"real search of {fw.name}")  # fmt: skip
         # Critical points the search could not prove: in boxes left undecided (a continuum
         # passes there) or set aside next to a cone point (a saddle leaves the cone point as
         # the other elements' pull there passes k L0): found by Newton, not proved unique.

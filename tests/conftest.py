@@ -92,12 +92,12 @@ def lose_first_root(monkeypatch) -> list:
 
     real_roots, dropped = boxes._roots, []
 
-    def lossy(land, lo, hi, k_lo, k_hi, acc, steps=40):
-        roots, found = real_roots(land, lo, hi, k_lo, k_hi, acc, steps)
-        if roots and not dropped:
+    def lossy(land, lo, hi, k_lo, k_hi, steps=40):
+        roots, found, good = real_roots(land, lo, hi, k_lo, k_hi, steps)
+        if len(roots) and not dropped:
             dropped.append(roots[0])
-            return roots[1:], found[1:]
-        return roots, found
+            return roots[1:], found[1:], good[1:]
+        return roots, found, good
 
     monkeypatch.setattr(boxes, "_roots", lossy)
     return dropped

@@ -74,6 +74,20 @@ def test_sin_sees_the_crest_inside_an_interval():
     assert s.hi[0] == 1.0 and s.hi[1] == 1.0 and s.lo[2] == -1.0
 
 
+def test_a_number_per_box_is_exact_where_one_given_alone_is():
+    """Numbers per box (a family's parameters, search_each) give each box the bounds the same
+    number alone gives it: x * 1 and x + 0 stay exact (not widened by an ulp), any other
+    number rounded outwards as alone."""
+    x = Interval(np.array([0.1, 0.2, 0.3, -0.7]), np.array([0.25, 0.5, 0.9, 0.4]))
+    for c in (np.array([1.0, 2.5, 0.0, -1.0]), np.array([0.0, 1.0, 1e-3, 3.0])):
+        for op in (lambda u, v: u * v, lambda u, v: v * u, lambda u, v: u + v):
+            per_box = op(x, c)
+            for i, ci in enumerate(c):
+                alone = op(Interval(x.lo[i], x.hi[i]), float(ci))
+                assert (per_box.lo[i], per_box.hi[i]) == (alone.lo, alone.hi), (i, ci)
+    assert (x * np.ones(4)).lo[0] == 0.1 and (x + np.zeros(4)).hi[2] == 0.9
+
+
 # --- the X-module against an energy written here -------------------------------------------------
 # examples/xmodule.toml: bars from a = (0, 0) and b = (1, 0), length 1.3; spring between the tips
 # (k 1, L0s); cables bar1 tip - b and bar2 tip - a (k 2, L0c), tension only; load fy on bar1's tip.
@@ -237,6 +251,45 @@ def test_real_and_complex_routes_give_the_same_physical_rows(name, values):
     assert gap[:, :-2].max() < 1e-8 and np.abs(a[:, -2:] - b[:, -2:]).max() < 1e-8
 
 
+# --- a sweep's points searched together -----------------------------------------------------------
+def test_searches_together_equal_each_search_alone():
+    """search_each over a family (a batch holding every member's step) gives each member its
+    own search, box for box: at L0c = 1.3 (a free length of exactly 1 in the framework's
+    units: a number per box kept exact, as one given alone is) and fy = 0 (a continuum of
+    equilibria, boxes left undecided)."""
+    from cotm_bertini.backends.boxes import MIN_WIDTH, SHORT, search, search_each
+    from cotm_bertini.backends.real_route import TorusFamily, TorusFramework
+
+    fw = cb.Framework.from_toml(XMODULE)
+    lands = [TorusFramework(fw.replace(L0c=a, fy=b))
+             for a, b in [(1.3, -0.05), (1.05, -0.2), (1.15, 0.0)]]  # fmt: skip
+    together = search_each(TorusFamily(lands), SHORT, MIN_WIDTH)
+    fields = ("roots", "root_boxes", "set_aside_boxes", "undecided", "boxes", "set_aside",
+              "set_aside_bound", "shortest_length", "newton_failed")  # fmt: skip
+    for land, got in zip(lands, together, strict=True):
+        alone = search(land, SHORT, MIN_WIDTH)
+        for name in fields:
+            np.testing.assert_array_equal(getattr(got, name), getattr(alone, name), name)
+    assert len(together[2].undecided) and len(together[0].roots) == 12
+
+
+def test_a_sweeps_points_searched_together_equal_an_independent_newton_search():
+    """A 2 x 2 sweep on the real route (its points' searches in one batch): each point's
+    physical rows, energies and Morse indices equal Newton's on the energy written here."""
+    fw = cb.Framework.from_toml(XMODULE)
+    sw = cb.sweep(fw, "L0c", [1.05, 1.3], param2="fy", values2=[-0.2, -0.05], route="real")
+    table = sw.table
+    for (L0c, fy), rows in table[table["physical"]].groupby(["L0c", "fy"]):
+        theta, V, eig = _x_reference(L0c=L0c, fy=fy)
+        pick, gap = _pair(rows[["bar1.angle_deg", "bar2.angle_deg"]].to_numpy(float),
+                          np.degrees(theta))  # fmt: skip
+        assert gap.max() < MATCH_DEG, (L0c, fy)
+        got = rows.iloc[pick]
+        np.testing.assert_allclose(got["energy"], V, atol=1e-10)
+        np.testing.assert_array_equal(got["index"].to_numpy(int), (eig < 0).sum(axis=1))
+    assert table.groupby(["L0c", "fy"]).ngroups == 4 and set(table["status"]) == {"ok"}
+
+
 # --- what the search cannot decide, and a sabotaged search -------------------------------------
 def test_a_search_stopped_early_is_incomplete_never_ok(tmp_path):
     fw = cb.Framework.from_toml(XMODULE)
@@ -391,3 +444,33 @@ def test_the_maps_folds_and_switches_against_the_independent_energy(xmodule_map)
                 H = np.stack([(_x_energy(t + h * e, **values)[1] - _x_energy(t - h * e,
                               **values)[1])[0] / (2 * h) for e in np.eye(2)])  # fmt: skip
                 assert abs(np.linalg.det(H)) < 1e-5 * np.abs(H).max() ** 2 + 1e-7
+
+
+def test_a_seed_lines_branches_are_traced_once_for_a_taut_sets_curve_systems():
+    """The sweep route's branches along a seed line depend on the taut set's equilibria, not on
+    the curve system: a switch system given the fold system's branches finds the seeds (and
+    line records) it finds tracing its own; another taut set's lines never share them."""
+    from cotm_bertini.catastrophe.curve_trace import Window
+    from cotm_bertini.catastrophe.fold_sweep import branch_key, sweep_seeds
+    from cotm_bertini.catastrophe.framework_folds import _line_specs
+    from cotm_bertini.model.framework.folds import curve_system
+
+    fw = cb.Framework.from_toml(ROOT / "examples" / "zeeman_cables.toml")
+    both, one = ("band_p", "band_u"), ("band_p",)
+    fold, switch = (curve_system(fw, both, "x", "y", c) for c in ("", "band_u"))
+    sx, sy = fold.scales
+    n = len(fold.variables)
+    win = Window(n, n + 1, (-0.6 / sx, -0.8 / sy), (0.8 / sx, 0.2 / sy), (sx, sy))
+    specs = [_line_specs(win)[k] for k in (0, 4, 8, 9, 13, 17)]  # edges and middles
+    args = (("x", "y"), cb.Settings(), lambda fn, tasks: [fn(t) for t in tasks])
+    shared: dict = {}
+    sweep_seeds(fw, fold, specs, *args, branches=shared)
+    assert len(shared) == len(specs)
+    got = sweep_seeds(fw, switch, specs, *args, branches=shared)
+    alone = sweep_seeds(fw, switch, specs, *args, branches={})
+    assert len(shared) == len(specs)  # every line's branches were the fold system's
+    assert len(got[0]) == len(alone[0]) > 0 and got[1] == alone[1]
+    np.testing.assert_array_equal(np.array(got[0]), np.array(alone[0]))
+    other = curve_system(fw, one, "x", "y", "band_p")
+    ts = np.linspace(0.0, 1.0, 3)
+    assert branch_key(other, specs[0], ts, []) != branch_key(switch, specs[0], ts, [])

@@ -23,6 +23,7 @@ its halvings.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 from dataclasses import dataclass, field
@@ -63,6 +64,18 @@ class BoxLandscape(Protocol):
 
     # Optional: `domain(start) -> (lo, hi)`, the boxes that cover the configuration space
     # (charts of a sphere, say); without it the torus grid of `initial_boxes`.
+
+
+class BoxFamily(Protocol):
+    """One landscape at several parameter values (`members`), searched together (search_each):
+    `rows(member)` is the landscape over a batch whose box i belongs to member[i]; that
+    landscape's `sub(rows)` is the one over the boxes `rows` of its batch."""
+
+    n: int
+    members: int
+
+    def rows(self, member: np.ndarray) -> BoxLandscape:
+        """The landscape over a batch of boxes, box i at member[i]'s parameter values."""
 
 
 @dataclass
@@ -122,46 +135,115 @@ def search(
     """Decide every box of the domain (module docstring), or of `boxes` (lo, hi) where given
     (a share of it, for a worker); stop at `max_boxes` or `max_seconds` with the boxes not yet
     decided listed as undecided."""
-    t0, c0 = time.perf_counter(), time.process_time()
     first = boxes if boxes is not None else domain(land, start)
+    return _search(land, 1, first, short, min_width, max_boxes, max_seconds, label)[0]
+
+
+def search_each(
+    family: BoxFamily,
+    short: float,
+    min_width: float,
+    start: int = 8,
+    max_boxes: int | None = None,
+    max_seconds: float | None = None,
+    label: str = "real search",
+) -> list[BoxSearch]:
+    """`search` of each member of a family (one landscape at several parameter values) over
+    the whole domain, all in the same batches of boxes: each member's search takes the steps
+    its own search would (its boxes, roots and lists equal, in the same order), and a batch
+    holds every member's step, so numpy's loops, not Python, set the pace. `max_boxes` is
+    each member's; `max_seconds` each member's share of the time (all stop at
+    members x max_seconds)."""
+    first = domain(family, start)
+    return _search(family, family.members, first, short, min_width, max_boxes, max_seconds,
+                   label)  # fmt: skip
+
+
+@dataclass
+class _Member:
+    """One search's state: its stack of boxes to decide and what it established so far."""
+
+    stack: list
+    deferred: list = field(default_factory=list)  # boxes waiting for the Krawczyk test
+    roots: list = field(default_factory=list)
+    root_boxes: list = field(default_factory=list)
+    undecided: list = field(default_factory=list)
+    aside_boxes: list = field(default_factory=list)
+    boxes: int = 0
+    aside: int = 0
+    bound: float = 0.0
+    shortest: float = math.inf
+    failed: int = 0
+    budget: str = ""
+
+    def stop(self, why: str) -> None:
+        """Every box not yet decided listed as undecided (the next batch first), with why the
+        search stopped."""
+        self.budget = why
+        self.undecided += [np.hstack([a, b]) for a, b in self.stack + self.deferred]
+        self.stack, self.deferred = [], []
+
+    def live(self) -> bool:
+        return bool(self.stack or self.deferred)
+
+    def next_batch(self) -> tuple[np.ndarray, np.ndarray, bool]:
+        """(lo, hi, for the Krawczyk test): the boxes waiting for the test once KRAWCZYK_BATCH
+        of them are (or nothing else is), else the next BATCH from the stack. The test's slope
+        matrix costs the same per call for 10 boxes as for 1,000 (prism_slack: a third of the
+        search went in 332 small calls)."""
+        if not self.stack or sum(len(d[0]) for d in self.deferred) >= KRAWCZYK_BATCH:
+            lo = np.vstack([d[0] for d in self.deferred])
+            hi = np.vstack([d[1] for d in self.deferred])
+            self.deferred = []
+            return lo, hi, True
+        return (*_take(self.stack, BATCH), False)
+
+    def result(self, n: int, clocks: tuple, volume: float) -> BoxSearch:
+        """The record (`clocks`: this search's wall and CPU seconds)."""
+        return BoxSearch(
+            _rows(self.roots, n), _rows(self.root_boxes, 2 * n), self.failed,
+            self.aside, self.bound, _rows(self.aside_boxes, 2 * n), _rows(self.undecided, 2 * n),
+            self.boxes, clocks[0], self.shortest, self.budget, volume=volume,
+            cpu_seconds=clocks[1],
+        )  # fmt: skip
+
+
+def _search(land, members: int, first: tuple, short, min_width, max_boxes, max_seconds, label):
+    """The members' searches in lockstep: each step takes every live member's next batch (as
+    its own search would) into one call of `_step`, and hands each its rows of the outcome."""
+    t0, c0 = time.perf_counter(), time.process_time()
+    n = first[0].shape[1]
     volume = float(np.prod(first[1] - first[0], axis=1).sum())
-    stack, deferred = [first], []
-    roots, root_boxes, undecided = [], [], []
-    acc = _tally()
-    pending, budget = 1.0, ""
+    group = [_Member([first]) for _ in range(members)]
+    pending = float(members)
     report = Progress(label, 1.0, "of the poses decided")
-    while stack or deferred:
-        # Boxes small enough for the Krawczyk test wait until KRAWCZYK_BATCH of them are
-        # pending (or nothing else is): its slope matrix costs the same per call for 10 boxes
-        # as for 1,000 (prism_slack: a third of the search went in 332 small calls).
-        testing = not stack or sum(len(d[0]) for d in deferred) >= KRAWCZYK_BATCH
-        if testing:
-            lo, hi = np.vstack([d[0] for d in deferred]), np.vstack([d[1] for d in deferred])
-            deferred = []
-        else:
-            lo, hi = _take(stack, BATCH)
-        share = float(np.prod(hi - lo, axis=1).sum()) / volume
-        if (max_boxes and acc["boxes"] >= max_boxes) or (
-            max_seconds and time.perf_counter() - t0 > max_seconds
-        ):
-            budget = f"stopped at {acc['boxes']:,} boxes after {time.perf_counter() - t0:.1f} s"
-            for a, b in [(lo, hi), *stack, *deferred]:
-                undecided.append(np.hstack([a, b]))
+    while True:
+        elapsed = time.perf_counter() - t0
+        for m in group:
+            if m.live() and ((max_boxes and m.boxes >= max_boxes) or (
+                    max_seconds and elapsed > max_seconds * members)):  # fmt: skip
+                m.stop(f"stopped at {m.boxes:,} boxes after {elapsed:.1f} s")
+        live = [k for k, m in enumerate(group) if m.live()]
+        if not live:
             break
-        acc["boxes"] += 0 if testing else len(lo)  # a deferred box was counted when taken
-        split, found, left, later = _step(land, lo, hi, short, min_width, acc, testing)
-        roots += found[0]
-        root_boxes += found[1]
-        if len(left):
-            undecided.append(left)
-        for part, into in ((split, stack), (later, deferred)):
-            if len(part[0]):
-                into.append(part)
-                share -= float(np.prod(part[1] - part[0], axis=1).sum()) / volume
-        pending -= share
-        report.set(1.0 - pending, note=f"{acc['boxes']:,} boxes")
+        takes = [group[k].next_batch() for k in live]
+        sizes = np.array([len(a) for a, _, _ in takes])
+        lo = takes[0][0] if len(takes) == 1 else np.vstack([a for a, _, _ in takes])
+        hi = takes[0][1] if len(takes) == 1 else np.vstack([b for _, b, _ in takes])
+        testing = np.repeat([t for _, _, t in takes], sizes)
+        view = land.rows(np.repeat(live, sizes)) if hasattr(land, "rows") else land
+        out = _step(view, lo, hi, short, min_width, testing)
+        ends = np.cumsum(sizes)
+        for k, part, (_, _, tested) in zip(live, out.parts(ends), takes, strict=True):
+            part.record(group[k], counted=tested)
+        decided = float(np.prod(hi - lo, axis=1).sum())
+        for a, b in (out.split, out.later):
+            decided -= float(np.prod(b - a, axis=1).sum())
+        pending -= decided / volume
+        report.set(1.0 - pending / members, note=f"{sum(m.boxes for m in group):,} boxes")
     report.close()
-    return _record(land.n, acc, (roots, root_boxes, undecided), (t0, c0), budget, volume)
+    clocks = ((time.perf_counter() - t0) / members, (time.process_time() - c0) / members)
+    return [m.result(n, clocks, volume) for m in group]
 
 
 def spread(
@@ -173,35 +255,15 @@ def spread(
     volume of `first`). Their fate is what `search` gives them: a box's is its own."""
     t0, c0 = time.perf_counter(), time.process_time()
     volume = float(np.prod(first[1] - first[0], axis=1).sum())
-    (lo, hi), acc, found = first, _tally(), ([], [], [])
+    (lo, hi), m = first, _Member([])
     for _ in range(steps):
         if not len(lo) or len(lo) >= want:
             break
-        acc["boxes"] += len(lo)
-        (lo, hi), (roots, root_boxes), left, _ = _step(land, lo, hi, short, min_width, acc, True)
-        found[0].extend(roots)
-        found[1].extend(root_boxes)
-        if len(left):
-            found[2].append(left)
-    return (lo, hi), _record(land.n, acc, found, (t0, c0), "", volume)
-
-
-def _tally() -> dict:
-    """What a search counts as it goes (`_step` adds to it)."""
-    return {"boxes": 0, "aside": 0, "bound": 0.0, "shortest": math.inf, "failed": 0,
-            "aside_boxes": []}  # fmt: skip
-
-
-def _record(n: int, acc: dict, found: tuple, clocks: tuple, budget: str, volume: float):
-    """A BoxSearch from the tally, (roots, their boxes, undecided parts), the wall and CPU
-    clocks at the start."""
-    roots, root_boxes, undecided = found
-    return BoxSearch(
-        np.array(roots).reshape(-1, n), np.array(root_boxes).reshape(-1, 2 * n), acc["failed"],
-        acc["aside"], acc["bound"], _rows(acc["aside_boxes"], n), _rows(undecided, n),
-        acc["boxes"], time.perf_counter() - clocks[0], acc["shortest"], budget, volume=volume,
-        cpu_seconds=time.process_time() - clocks[1],
-    )  # fmt: skip
+        out = _step(land, lo, hi, short, min_width, np.ones(len(lo), dtype=bool))
+        out.parts(np.array([len(lo)]))[0].record(m, counted=False)
+        lo, hi = m.stack.pop() if m.stack else (lo[:0], hi[:0])
+    clocks = (time.perf_counter() - t0, time.process_time() - c0)
+    return (lo, hi), m.result(lo.shape[1], clocks, volume)
 
 
 def merged(parts: list[BoxSearch], volume: float, seconds: float, apart: float = 1e-8):
@@ -219,7 +281,7 @@ def merged(parts: list[BoxSearch], volume: float, seconds: float, apart: float =
     if len(keep) < len(roots):
         notes.append(f"{len(roots) - len(keep)} roots proved in two shares' boxes kept once")
     total = lambda name: sum(getattr(p, name) for p in parts)  # noqa: E731
-    boxes = lambda name: _rows([getattr(p, name) for p in parts], n)  # noqa: E731
+    boxes = lambda name: _rows([getattr(p, name) for p in parts], 2 * n)  # noqa: E731
     return BoxSearch(
         roots[keep], boxes("root_boxes")[keep], total("newton_failed"), total("set_aside"),
         max(p.set_aside_bound for p in parts), boxes("set_aside_boxes"), boxes("undecided"),
@@ -250,8 +312,8 @@ def distinct(points: np.ndarray, apart: float) -> np.ndarray:
     return np.array(keep, dtype=np.int64)
 
 
-def _rows(parts: list, n: int) -> np.ndarray:
-    return np.vstack(parts) if parts else np.zeros((0, 2 * n))
+def _rows(parts: list, width: int) -> np.ndarray:
+    return np.vstack(parts).reshape(-1, width) if parts else np.zeros((0, width))
 
 
 def _take(stack: list, count: int) -> tuple[np.ndarray, np.ndarray]:
@@ -272,68 +334,161 @@ def _take(stack: list, count: int) -> tuple[np.ndarray, np.ndarray]:
     return np.vstack(los), np.vstack(his)
 
 
-def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, acc: dict, testing: bool):
-    """One batch: (boxes to split (lo, hi), (roots, their boxes), undecided (k, 2n), boxes
-    for the Krawczyk test (lo, hi): tested here if `testing`, else handed back)."""
+@dataclass
+class _Outcome:
+    """One batch's verdicts, by row of the batch (each `*_rows` ascending): the boxes set
+    aside (`aside`: those short or at the smallest width, then `cone`: next to a cone point),
+    with the bound of each; the leaves' shortest spring; the roots; the boxes left undecided;
+    the boxes to split (lo, hi) with the row each came from (`parent`)."""
+
+    rows: int
+    aside_rows: np.ndarray
+    aside: np.ndarray  # (k, 2n + 1): lo, hi, the spring bound
+    cone_rows: np.ndarray
+    cone: np.ndarray
+    leaf_rows: np.ndarray
+    leaf_short: np.ndarray
+    root_rows: np.ndarray
+    roots: np.ndarray  # (r, n)
+    root_boxes: np.ndarray  # (r, 2n)
+    root_good: np.ndarray  # (r,): Newton converged inside K n X
+    left_rows: np.ndarray
+    left: np.ndarray
+    split: tuple[np.ndarray, np.ndarray]
+    parent: np.ndarray
+    later_rows: np.ndarray
+    later: tuple[np.ndarray, np.ndarray]  # boxes for the Krawczyk test, handed back
+
+    def parts(self, ends: np.ndarray) -> list[_Part]:
+        """Each member's share of the outcome (the members' rows end at `ends`)."""
+        if len(ends) == 1:
+            return [_Part(int(ends[0]), self.aside, self.cone, self.leaf_short, self.roots,
+                          self.root_boxes, self.root_good, self.left, self.split,
+                          self.later)]  # fmt: skip
+        cut = lambda rows, *arrays: [np.split(a, np.searchsorted(rows, ends[:-1]))  # noqa: E731
+                                     for a in arrays]  # fmt: skip
+        aside, cone = cut(self.aside_rows, self.aside)[0], cut(self.cone_rows, self.cone)[0]
+        (short,) = cut(self.leaf_rows, self.leaf_short)
+        roots, boxes, good = cut(self.root_rows, self.roots, self.root_boxes, self.root_good)
+        (left,) = cut(self.left_rows, self.left)
+        later = zip(*cut(self.later_rows, *self.later), strict=True)
+        member = np.searchsorted(ends, self.parent, side="right")
+        order = np.argsort(member, kind="stable")  # each member's children in their order
+        at = np.searchsorted(member[order], np.arange(1, len(ends)))
+        lo, hi = (np.split(a[order], at) for a in self.split)
+        sizes = np.diff(ends, prepend=0)
+        return [_Part(*v) for v in zip(sizes, aside, cone, short, roots, boxes, good, left,
+                                        zip(lo, hi, strict=True), later, strict=True)]  # fmt: skip
+
+
+@dataclass
+class _Part:
+    """One member's share of a batch's outcome (see _Outcome)."""
+
+    boxes: int
+    aside: np.ndarray
+    cone: np.ndarray
+    leaf_short: np.ndarray
+    roots: np.ndarray
+    root_boxes: np.ndarray
+    root_good: np.ndarray
+    left: np.ndarray
+    split: tuple[np.ndarray, np.ndarray]
+    later: tuple[np.ndarray, np.ndarray]
+
+    def record(self, m: _Member, counted: bool) -> None:
+        """Into the member's search: counts (the boxes unless `counted` when first taken),
+        bounds, lists, the boxes to split pushed and those for the Krawczyk test kept."""
+        m.boxes += 0 if counted else int(self.boxes)
+        for rows in (self.aside, self.cone):
+            if len(rows):
+                m.aside += len(rows)
+                m.aside_boxes.append(rows[:, :-1])
+                m.bound = max(m.bound, float(rows[:, -1].max()))
+        if len(self.leaf_short):
+            m.shortest = min(m.shortest, float(self.leaf_short.min()))
+        if len(self.roots):
+            m.roots.append(self.roots)
+            m.root_boxes.append(self.root_boxes)
+            m.failed += int((~self.root_good).sum())
+        if len(self.left):
+            m.undecided.append(self.left)
+        if len(self.split[0]):
+            m.stack.append(self.split)
+        if len(self.later[0]):
+            m.deferred.append(self.later)
+
+
+def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, testing) -> _Outcome:
+    """One batch: each box set aside, excluded, proved to hold one root, left, split, or (a
+    box small enough for the Krawczyk test, where `testing` is False) handed back for it."""
     box = Interval(lo, hi)
+    rows = np.arange(len(lo))
     width = (hi - lo).max(axis=1)
     dd, grad, states = land.enclose(box)
     aside, smooth = np.zeros(len(lo), dtype=bool), np.ones(len(lo), dtype=bool)
     floor = np.full(len(lo), float(min_width))
-    if dd.lo.shape[1]:
+    springs = dd.lo.shape[1] > 0
+    if springs:
         smooth = ~(dd.lo <= short * short).any(axis=1)
         aside = (dd.hi < short * short).any(axis=1) | (~smooth & (width <= min_width))
-        if aside.any():
-            _set_aside(acc, lo[aside], hi[aside], dd.hi[aside])
         floor = _floor(dd, min_width)
     decided, later = np.zeros(len(lo), dtype=bool), np.zeros(len(lo), dtype=bool)
-    found: tuple[list, list] = ([], [])
     test = np.flatnonzero(~aside & smooth)
+    n = lo.shape[1]
+    found = (rows[:0], np.zeros((0, n)), np.zeros((0, 2 * n)), np.zeros(0, dtype=bool))
     if len(test):
         zero = grad[test].contains_zero().all(axis=1)
         decided[test[~zero]] = True
         cand = test[zero & (width[test] <= KRAWCZYK_WIDTH)]
-        if len(cand) and not testing:
-            later[cand] = True
-        elif len(cand):
-            verdict, k_lo, k_hi = krawczyk(land, lo[cand], hi[cand], _subset(states, cand))
+        later[cand[~testing[cand]]] = True
+        cand = cand[testing[cand]]
+        if len(cand):
+            verdict, k_lo, k_hi = krawczyk(_sub(land, cand), lo[cand], hi[cand],
+                                           _subset(states, cand))  # fmt: skip
             decided[cand[verdict != 0]] = True
             one = verdict == 1
             if one.any():
-                found = _roots(land, lo[cand[one]], hi[cand[one]], k_lo[one], k_hi[one], acc)
-    leaf = ~aside & (decided | ~smooth)
-    if dd.lo.shape[1] and leaf.any():
-        low = np.sqrt(np.maximum(dd.lo[leaf].min(axis=1), 0.0)).min()
-        acc["shortest"] = min(acc["shortest"], float(low))
+                at = cand[one]
+                found = (at, *_roots(_sub(land, at), lo[at], hi[at], k_lo[one], k_hi[one]))
+    leaf = ~aside & (decided | ~smooth) if springs else np.zeros(len(lo), dtype=bool)
     rest = ~aside & ~decided & ~later
     small = rest & (width <= floor)
     if small.any():  # a root in or next to the box: split on (Krawczyk wants small boxes there)
-        near = _root_near(land, lo[small], hi[small])
-        small[np.flatnonzero(small)[near & (width[small] > ROOT_FLOOR)]] = False
-    if small.any() and dd.lo.shape[1]:
+        at = np.flatnonzero(small)
+        near = _root_near(_sub(land, at), lo[at], hi[at])
+        small[at[near & (width[at] > ROOT_FLOOR)]] = False
+    cone = np.zeros(len(lo), dtype=bool)
+    if small.any() and springs:
         # Next to a cone point the 1/d terms keep the enclosures too wide to decide: such a
         # box is set aside as the short ones are (its spring bound counted), not undecided.
         cone = small & (dd.lo < (NEAR_CONE * short) ** 2).any(axis=1)
-        if cone.any():
-            _set_aside(acc, lo[cone], hi[cone], dd.hi[cone])
-            small &= ~cone
-    left = np.hstack([lo[small], hi[small]])
+        small &= ~cone
     # Next to a cone point (a spring may be short) nothing is tested until the boxes are set
     # aside at the smallest width: two halvings at once there save a batch step each.
     deep = rest & ~small & ~smooth & (width > 4 * min_width)
-    plain = _split(lo[rest & ~small & ~deep], hi[rest & ~small & ~deep])
-    twice = _split(*_split(lo[deep], hi[deep]))
-    split = (np.vstack([plain[0], twice[0]]), np.vstack([plain[1], twice[1]]))
-    return split, found, left, (lo[later], hi[later])
+    plain = rest & ~small & ~deep
+    once = _split(lo[plain], hi[plain], rows[plain])
+    twice = _split(*_split(lo[deep], hi[deep], rows[deep]))
+    bound = lambda m: np.hstack([lo[m], hi[m], _spring_bound(dd.hi[m])[:, None]])  # noqa: E731
+    low = np.sqrt(np.maximum(dd.lo[leaf].min(axis=1), 0.0)) if springs else np.zeros(0)
+    return _Outcome(
+        len(lo), rows[aside], bound(aside), rows[cone], bound(cone), rows[leaf], low, *found,
+        rows[small], np.hstack([lo[small], hi[small]]), (np.vstack([once[0], twice[0]]),
+        np.vstack([once[1], twice[1]])), np.concatenate([once[2], twice[2]]),
+        rows[later], (lo[later], hi[later]),
+    )  # fmt: skip
 
 
-def _set_aside(acc: dict, lo: np.ndarray, hi: np.ndarray, dd_hi: np.ndarray) -> None:
-    """Boxes set aside at a cone point: counted, kept, and their spring bound taken (in each,
-    some spring with a free length is at most sqrt(min dd_hi) long)."""
-    acc["aside"] += len(lo)
-    acc["aside_boxes"].append(np.hstack([lo, hi]))
-    longest = np.sqrt(np.maximum(dd_hi.min(axis=1), 0.0)).max()
-    acc["bound"] = max(acc["bound"], float(longest))
+def _spring_bound(dd_hi: np.ndarray) -> np.ndarray:
+    """In each box set aside some spring with a free length is at most this long."""
+    return np.sqrt(np.maximum(dd_hi.min(axis=1), 0.0)) if dd_hi.shape[1] else np.zeros(len(dd_hi))
+
+
+def _sub(land, rows: np.ndarray):
+    """The landscape over the batch's boxes `rows` (a family's view keeps each box's member)."""
+    sub = getattr(land, "sub", None)
+    return land if sub is None else sub(rows)
 
 
 def _root_near(land: BoxLandscape, lo: np.ndarray, hi: np.ndarray, steps: int = 8) -> np.ndarray:
@@ -370,13 +525,13 @@ def _floor(dd: Interval, min_width: float) -> np.ndarray:
     return np.maximum(np.minimum(min_width, 0.01 * shortest), ROOT_FLOOR)
 
 
-def _split(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _split(lo: np.ndarray, hi: np.ndarray, parent: np.ndarray) -> tuple:
     """Each box halved along its MAX_CUTS widest sides (those at least half as wide as its
-    widest): in six or eight dimensions a box cut along every side makes 64 or 256 boxes
-    where the first halvings would often have excluded half of them (prism_slack: 15.8 million
-    boxes -> 2.6 million)."""
+    widest): (lo, hi, the `parent` of each half's box). In six or eight dimensions a box cut
+    along every side makes 64 or 256 boxes where the first halvings would often have excluded
+    half of them (prism_slack: 15.8 million boxes -> 2.6 million)."""
     if not len(lo):
-        return lo, hi
+        return lo, hi, parent
     w = hi - lo
     widest = np.argsort(-w, axis=1, kind="stable")[:, :MAX_CUTS]
     cut = np.zeros(w.shape, dtype=bool)
@@ -390,8 +545,9 @@ def _split(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         hi = hi.copy()
         hi[np.flatnonzero(c), j] = mid
         lo, hi = np.vstack([lo, upper_lo]), np.vstack([hi, upper_hi])
+        parent = np.concatenate([parent, parent[c]])
         cut = np.vstack([cut, cut[c]])
-    return lo, hi
+    return lo, hi, parent
 
 
 def krawczyk(land: BoxLandscape, lo: np.ndarray, hi: np.ndarray, states) -> tuple:
@@ -420,8 +576,9 @@ def krawczyk(land: BoxLandscape, lo: np.ndarray, hi: np.ndarray, states) -> tupl
     return verdict, k.lo, k.hi
 
 
-def _roots(land: BoxLandscape, lo, hi, k_lo, k_hi, acc: dict, steps: int = 40):
-    """Newton from the middle of K n X to the critical point each box holds alone."""
+def _roots(land: BoxLandscape, lo, hi, k_lo, k_hi, steps: int = 40) -> tuple:
+    """Newton from the middle of K n X to the critical point each box holds alone: (roots,
+    their boxes (lo, hi), whether each ended inside K n X)."""
     a, b = np.maximum(lo, k_lo), np.minimum(hi, k_hi)
     x = 0.5 * (a + b)
     done = np.zeros(len(x), dtype=bool)
@@ -429,19 +586,28 @@ def _roots(land: BoxLandscape, lo, hi, k_lo, k_hi, acc: dict, steps: int = 40):
         live = np.flatnonzero(~done)
         if not len(live):
             break
-        g, h = point_derivatives(land, x[live])
-        try:
-            dx = np.linalg.solve(h, g[..., None])[..., 0]
-        except np.linalg.LinAlgError:
-            break
+        g, h = point_derivatives(_sub(land, live), x[live])
+        dx = _newton_steps(h, g)
         new = x[live] - dx
         inside = ((new >= a[live]) & (new <= b[live])).all(axis=1)
         x[live] = np.where(inside[:, None], new, x[live])
         small = np.abs(dx).max(axis=1) <= 1e-15 * (1 + np.abs(new).max(axis=1))
         done[live[small | ~inside]] = True
     good = ((x >= a) & (x <= b)).all(axis=1)
-    acc["failed"] += int((~good).sum())
-    return list(x), list(np.hstack([lo, hi]))
+    return x, np.hstack([lo, hi]), good
+
+
+def _newton_steps(h: np.ndarray, g: np.ndarray) -> np.ndarray:
+    """H^-1 g for each point; NaN where its Hessian is singular (that point's Newton stops,
+    not the batch's)."""
+    try:
+        return np.linalg.solve(h, g[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        out = np.full_like(g, np.nan)
+        for i in range(len(g)):
+            with contextlib.suppress(np.linalg.LinAlgError):
+                out[i] = np.linalg.solve(h[i], g[i])
+        return out
 
 
 def point_derivatives(land: BoxLandscape, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

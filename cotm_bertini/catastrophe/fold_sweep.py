@@ -14,6 +14,7 @@ spacing), or a pair of turning points closer together than the trace's steps.
 
 from __future__ import annotations
 
+import hashlib
 from functools import cache
 
 import numpy as np
@@ -50,12 +51,14 @@ def run_reported(run: Run, fn, tasks: list, stage: str, unit: str, batch: int = 
 
 def sweep_seeds(
     fw: Framework, cs: CurveSystem, specs: list, names, settings: Settings, run: Run,
-    what: str = "fold seeds", batch: int = 1,
+    what: str = "fold seeds", batch: int = 1, branches: dict | None = None,
 ) -> tuple[list[np.ndarray], list[dict]]:  # fmt: skip
     """The fold points on each line (x0, y0, dx, dy) of `specs` (a grid: see the module
     docstring), as points (X, mx, my), and a record of each line. `names`: the map parameters;
     `run`: runs the tasks (runner.worker_pool): the crossings' solves by vertical line, then
-    the lines, in batches of `batch` with progress lines headed `what`."""
+    the lines, in batches of `batch` with progress lines headed `what`. `branches`: the lines'
+    branches traced so far (branch_key -> list of Traced), used and added to: a taut set's fold
+    and switch systems share their equilibria, so each line's branches are traced once."""
     ts = np.linspace(0.0, 1.0, _samples(specs))
     vertical = [s for s in specs if s[2] == 0.0]  # every crossing lies on one of them
     run(_generic_sets, [(fw, cs, settings)])  # once, on disk, before the workers need them
@@ -65,16 +68,38 @@ def sweep_seeds(
     # On the real route a crossing's search serves every curve system of the map (kept in this
     # process, real_route.real_equilibria): searched here, once, not in a worker each time.
     real = framework_route(fw, settings) == "real"
+    if real:  # all crossings searched together, in shared batches of boxes
+        from ..backends.real_route import real_equilibria_of
+
+        real_equilibria_of([_crossing(fw, cs, names, spec, t) for spec in vertical for t in ts])
     for part in run_reported(_here if real else run, _solve_line, tasks, stage, "lines", batch):
         solved.update(part)
-    tasks = [(cs, spec, ts, [solved[_key(spec, t)] for t in ts]) for spec in specs]
+    branches = {} if branches is None else branches
+    tasks, keys = [], []
+    for spec in specs:
+        on_line = [solved[_key(spec, t)] for t in ts]
+        keys.append(branch_key(cs, spec, ts, [pts for pts, *_ in on_line]))
+        tasks.append((cs, spec, ts, on_line, branches.get(keys[-1])))
     stage = f"{what}: branches and their turns along the seed lines"
     results = run_reported(run, _line_folds, tasks, stage, "lines", batch)
     seeds, lines = [], []
-    for found, record in results:
+    for key, (found, record, traced) in zip(keys, results, strict=True):
         seeds += found
         lines.append(record)
+        branches[key] = traced
     return seeds, lines
+
+
+def branch_key(cs: CurveSystem, spec, ts: np.ndarray, reals: list) -> str:
+    """What a line's branches (_branches) depend on: the equilibria F(X; mx, my) (a curve
+    system's first rows: the same for a taut set's fold and switch systems), the unknowns, the
+    line, its crossings and their real equilibria."""
+    F = _equilibria(cs)
+    h = hashlib.sha256(repr((F.variables, cs.variables, tuple(spec))).encode())
+    for a in (*F.exponents, *F.coefficients, ts, *reals):
+        h.update(repr(a.shape).encode())
+        h.update(np.ascontiguousarray(a).tobytes())
+    return h.hexdigest()
 
 
 def _here(fn, tasks: list) -> list:
@@ -140,23 +165,29 @@ def _real_line(task) -> dict:
     from ..backends.real_route import real_equilibria
 
     fw, cs, spec, ts, names, _ = task
-    sx, sy = cs.scales
     out = {}
     for t in ts:
-        mx, my = _key(spec, t)
-        groups, found = real_equilibria(fw.replace(**{names[0]: mx * sx, names[1]: my * sy}))
+        groups, found = real_equilibria(_crossing(fw, cs, names, spec, t))
         eps = groups.get(tuple(sorted(cs.taut)))
         if eps is not None and tuple(eps.variables) != cs.variables:
             raise AssertionError("the fold system's unknowns differ from the equilibria's")
         pts = eps.points.real if eps is not None else np.zeros((0, len(cs.variables)))
-        out[mx, my] = (pts, 0, len(found.undecided))
+        out[_key(spec, t)] = (pts, 0, len(found.undecided))
     return out
 
 
-def _line_folds(task) -> tuple[list[np.ndarray], dict]:
-    """One line's fold points (its branches' turns) and its record."""
-    cs, spec, ts, solved = task
-    branches = _branches(cs, spec, ts, [pts for pts, *_ in solved])
+def _crossing(fw: Framework, cs: CurveSystem, names, spec, t: float) -> Framework:
+    """The framework at the point t of a line."""
+    mx, my = _key(spec, t)
+    return fw.replace(**{names[0]: mx * cs.scales[0], names[1]: my * cs.scales[1]})
+
+
+def _line_folds(task) -> tuple[list[np.ndarray], dict, list[Traced]]:
+    """One line's fold points (its branches' turns), its record and its branches (traced
+    here unless given)."""
+    cs, spec, ts, solved, branches = task
+    if branches is None:
+        branches = _branches(cs, spec, ts, [pts for pts, *_ in solved])
     found, counts = _turning_folds(cs, spec, branches)
     record = {
         "line": [float(v) for v in spec], "points": len(ts), "branches": len(branches),
@@ -167,7 +198,7 @@ def _line_folds(task) -> tuple[list[np.ndarray], dict]:
         "lost": sum(s[1] for s in solved) if spec[2] == 0.0 else 0,
         "undecided_boxes": sum(s[2] for s in solved) if spec[2] == 0.0 else 0,
     }  # fmt: skip
-    return found, record
+    return found, record, branches
 
 
 def real_points(hs) -> np.ndarray:

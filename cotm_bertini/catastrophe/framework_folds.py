@@ -112,6 +112,7 @@ def framework_fold_curves(
     frames, record = [], {"taut_sets": {}}
     next_id = 0
     todo = _curve_systems(fw, centre, (xname, xrange, yname, yrange), kinds)
+    branches: dict = {}  # the sweep route's branches along the seed lines, by fold_sweep.branch_key
     with worker_pool(workers) as run:
         for k, (taut, cable) in enumerate(todo):
             cs = curve_system(centre, taut, xname, yname, cable)
@@ -127,7 +128,7 @@ def framework_fold_curves(
             axes = (xname, xrange), (yname, yrange)
             what = f"fold curves {k + 1}/{len(todo)} ({name}, taut set {' '.join(taut) or 'none'})"
             work = _Work(run, 2 * workers if workers > 1 else 1, what)
-            curves, info = _find(fw, cs, axes, settings, seeds, work)
+            curves, info = _find(fw, cs, axes, settings, seeds, work, branches)
             frame, next_id, about = _rows(fw, curves, (xname, yname), next_id, work)
             frames.append(frame)
             group[name] = {**info, **about}
@@ -240,8 +241,11 @@ def _line_seeds(cs, gs, win: Window, settings, what: str) -> tuple[list, list[di
     return seeds, lines
 
 
-def _find(fw: Framework, cs: CurveSystem, axes, settings, seeds: str, work: _Work) -> tuple:
-    """Seeds on lines (by the chosen route), and every curve through a seed traced once."""
+def _find(
+    fw: Framework, cs: CurveSystem, axes, settings, seeds: str, work: _Work, branches: dict
+) -> tuple:
+    """Seeds on lines (by the chosen route), and every curve through a seed traced once
+    (`branches`: the sweep route's, shared by the curve systems, fold_sweep.sweep_seeds)."""
     (xname, xrange), (yname, yrange) = axes
     t0 = time.perf_counter()
     sx, sy = cs.scales
@@ -268,7 +272,7 @@ def _find(fw: Framework, cs: CurveSystem, axes, settings, seeds: str, work: _Wor
         t1 = time.perf_counter()
         specs = _line_specs(win)
         seeds_found, lines = sweep_seeds(
-            fw, cs, specs, (xname, yname), settings, work.run, work.what, work.batch
+            fw, cs, specs, (xname, yname), settings, work.run, work.what, work.batch, branches
         )
         info.update(sweep_points=lines[0]["points"])
     t2 = time.perf_counter()

@@ -73,6 +73,16 @@ def solve_run(
     `names`, or None without `names`): the lines are written here, in parallel, not at the end.
     """
     settings = point_settings(spec)
+    if _searched_together(spec, indices, settings):
+        from ..backends.real_route import TOGETHER
+        from ..point import solve_framework_points
+
+        for at in range(0, len(indices), TOGETHER):
+            chunk = indices[at : at + TOGETHER]
+            solved = solve_framework_points([spec.params_at(i) for i in chunk], settings)
+            for index, one in zip(chunk, solved, strict=True):
+                yield _point_out(spec, index, one, names)
+        return
     recent: dict[int, tuple] = {}  # the last two rows' points: index -> (warm start, structure)
     keep = 2 * (len(spec.values2) if spec.param2 else 1) + 2
     for index in indices:
@@ -82,11 +92,29 @@ def solve_run(
         recent[index] = (solved.warm, structure)
         if len(recent) > keep:
             del recent[next(iter(recent))]
-        cols = point_columns(solved, spec.values_at(index), index)
-        if spec.certify:
-            _certify_point(params, solved, cols)
-        text = None if names is None else rows_text(cols, names)
-        yield index, cols, int(np.nan_to_num(cols["lost_paths"][:1]).sum()), text
+        yield _point_out(spec, index, solved, names)
+
+
+def _searched_together(spec: SweepSpec, indices: list[int], settings: Settings) -> bool:
+    """Whether the points are a framework's on the real route: their searches then run
+    together, real_route.TOGETHER at a time (point.solve_framework_points: the batches of boxes,
+    not Python's steps, set the pace; each point's search and rows as if solved alone)."""
+    if spec.framework is None or not indices:
+        return False
+    from ..point import framework_route
+
+    return framework_route(spec.params_at(indices[0]), settings) == "real"
+
+
+def _point_out(
+    spec: SweepSpec, index: int, solved: PointSolution, names: list[str] | None
+) -> tuple[int, Columns, int, str | None]:
+    """A solved point as solve_run yields it (certified first where the sweep asks)."""
+    cols = point_columns(solved, spec.values_at(index), index)
+    if spec.certify:
+        _certify_point(spec.params_at(index), solved, cols)
+    text = None if names is None else rows_text(cols, names)
+    return index, cols, int(np.nan_to_num(cols["lost_paths"][:1]).sum()), text
 
 
 def _solve(spec: SweepSpec, params, settings: Settings, warm) -> PointSolution:

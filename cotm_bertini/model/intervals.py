@@ -109,8 +109,13 @@ class Interval:
 
     def __add__(self, other) -> Interval:
         if not isinstance(other, Interval):
-            if np.ndim(other) == 0 and other == 0:
-                return self
+            if np.ndim(other) == 0:
+                if other == 0:
+                    return self
+            else:  # numbers per box: each 0 kept exact, as one given alone is
+                zero = np.asarray(other, dtype=float) == 0
+                out = self + Interval(other)
+                return Interval(np.where(zero, self.lo, out.lo), np.where(zero, self.hi, out.hi))
             other = Interval(other)
         # No NaN: a lower bound is never +inf (_down moves an overflow back to the largest
         # double) nor an upper bound -inf, so inf - inf cannot arise.
@@ -138,7 +143,10 @@ class Interval:
                 return self
             lo = np.where(c >= 0, c * self.lo, c * self.hi)
             hi = np.where(c >= 0, c * self.hi, c * self.lo)
-            return Interval(_down(np.where(c == 0, 0.0, lo)), _up(np.where(c == 0, 0.0, hi)))
+            lo, hi = _down(np.where(c == 0, 0.0, lo)), _up(np.where(c == 0, 0.0, hi))
+            if c.ndim:  # numbers per box: each 1 kept exact, as one given alone is
+                lo, hi = np.where(c == 1.0, self.lo, lo), np.where(c == 1.0, self.hi, hi)
+            return Interval(lo, hi)
         with np.errstate(invalid="ignore"):  # 0 * inf: below
             p = [self.lo * other.lo, self.lo * other.hi, self.hi * other.lo, self.hi * other.hi]
         # 0 * inf is nan; as a product of reals (an unbounded end stands for finite numbers) it

@@ -242,10 +242,18 @@ def _line_seeds(cs, gs, win: Window, settings, what: str) -> tuple[list, list[di
 
 
 def _find(
-    fw: Framework, cs: CurveSystem, axes, settings, seeds: str, work: _Work, branches: dict
+    fw: Framework,
+    cs: CurveSystem,
+    axes,
+    settings,
+    seeds: str,
+    work: _Work,
+    branches: dict | None = None,
 ) -> tuple:
     """Seeds on lines (by the chosen route), and every curve through a seed traced once
-    (`branches`: the sweep route's, shared by the curve systems, fold_sweep.sweep_seeds)."""
+    (`branches`: the sweep route's, shared by the curve systems, fold_sweep.sweep_seeds;
+    none given: this system's own)."""
+    branches = {} if branches is None else branches
     (xname, xrange), (yname, yrange) = axes
     t0 = time.perf_counter()
     sx, sy = cs.scales

@@ -121,7 +121,8 @@ class SphereFramework:
         return [(self.cables, self.full)]
 
     def domain(self, start: int) -> tuple[np.ndarray, np.ndarray]:
-        """The product of each node's chart boxes: 3^nodes boxes (lo, hi), each (count, n)."""
+        """The product of each node's chart boxes: 3^nodes boxes (lo, hi), each (count, n)
+        (`start`, the torus grid's divisions, has no part here: the charts are the start)."""
         parts = pieces()
         idx = np.indices((len(parts),) * len(self.nodes)).reshape(len(self.nodes), -1).T
         lo = np.array([[v for i in row for v in (parts[i][0][0], parts[i][1][0])] for row in idx])

@@ -26,6 +26,10 @@ from .pools import as_done
 # share walks its boxes down in as many batch steps as the whole search (about 1 ms of numpy's
 # overhead each): more than one share a worker only where the start boxes fill BATCH-box steps.
 SHARES_A_WORKER = 4
+# ... but a search over 4 or more dimensions takes minutes, and its hard boxes cluster (round
+# critical points): one share a worker left a worker idle for most of prism4's search.
+SHARES_A_WORKER_LARGE = 16
+LARGE = 4  # dimensions from which a search counts as large
 BOXES_A_SHARE = 16  # breadth-first steps until there are this many boxes a share to deal
 SPREAD_STEPS = 8  # ... at most (a 1-D domain of 8 boxes: 16 a share after a few steps)
 
@@ -58,7 +62,8 @@ def split_search(
     dealt: dict = {}  # what the breadth-first steps decided here, and the shares dealt
 
     def jobs(count: int) -> list[tuple]:
-        shares = max(1, count) * min(SHARES_A_WORKER, max(1, len(first[0]) // BATCH))
+        per = min(SHARES_A_WORKER, max(1, len(first[0]) // BATCH))
+        shares = max(1, count) * (SHARES_A_WORKER_LARGE if land.n >= LARGE else per)
         (lo, hi), done = spread(land, first, short, min_width, shares * BOXES_A_SHARE,
                                 SPREAD_STEPS)  # fmt: skip
         dealt["head"] = dataclasses.replace(done, shares=0, volume=volume)

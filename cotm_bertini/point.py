@@ -422,8 +422,9 @@ def _real_landscape(fw, t: Timings) -> tuple:
 def _solve_real(
     fw, settings: Settings, tolerances: Tolerances, t: Timings, ready=None, found=None
 ) -> PointSolution:
-    """Every real equilibrium of a framework on a circle or torus, by the branch and bound of
-    backends.boxes over its body angles (backends.real_route), classified as the complex route's
+    """Every real equilibrium of a framework on a circle, torus or product of spheres, by the
+    branch and bound of backends.boxes over its configuration space (backends.real_route,
+    backends.spheres), classified as the complex route's
     endpoints are; the search's proof (or what it left undecided) is the completeness check.
     Boxes left undecided are searched for continua of equilibria (where V is constant along a
     curve no box can be decided), traced and counted apart as on the complex route. `ready`

@@ -1,5 +1,6 @@
 """The real route: a framework whose poses form a circle or torus solved on the reals, by the
-branch and bound of `boxes` over its body angles, with no complex generic set.
+branch and bound of `boxes` over its body angles, with no complex generic set (one whose nodes
+hang by bars, a product of spheres, by backends.spheres: `covers` and `landscape` say which).
 
 V = sum k/2 (d - L0)^2 over springs + sum k/2 max(d - L0, 0)^2 over cables - the loads' work, so
 grad V = sum w r . dr/dangle + the loads' gradient, w = k (1 - L0/d) for a spring (k at zero free

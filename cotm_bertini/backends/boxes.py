@@ -464,6 +464,7 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, testing) -
         # box is set aside as the short ones are (its spring bound counted), not undecided.
         cone = small & (dd.lo < (NEAR_CONE * short) ** 2).any(axis=1)
         small &= ~cone
+        rest &= ~cone  # set aside: not split as well
     # Next to a cone point (a spring may be short) nothing is tested until the boxes are set
     # aside at the smallest width: two halvings at once there save a batch step each.
     deep = rest & ~small & ~smooth & (width > 4 * min_width)

@@ -250,7 +250,7 @@ class SphereFramework:
         """grad V and its Hessian at points (R, n chart angles) in double precision (each
         point's Hessian that of its taut set: slack cables' stiffness 0)."""
         count = len(x)
-        g, X, P, dirs = self._numeric(x)
+        g, X, P, dirs, _ = self._numeric(x)
         m = X.shape[1]
         full = np.zeros((count, len(self.full.ps.variables)))
         full[:, self.coords] = X
@@ -265,8 +265,8 @@ class SphereFramework:
 
     def _numeric(self, x: np.ndarray) -> tuple:
         """At points (R, n chart angles): grad V in node coordinates, the node coordinates,
-        the parameters with each slack cable's stiffness 0 (its taut set's Hessian), and the
-        directions with their derivatives."""
+        the parameters with each slack cable's stiffness 0 (its taut set's Hessian), the
+        directions with their derivatives, and each spring's and cable's length."""
         count = len(x)
         positions, dirs = self.kinematics(x)
         X = np.zeros((count, len(self.full.ps.variables)))
@@ -274,17 +274,17 @@ class SphereFramework:
         P = np.tile(np.asarray(self.P), (count, 1))
         first = self.full.numeric.first_order(X, P)
         m, per = len(positions), 3 + 3 * len(positions)
-        g = columns(first[len(self.links) * per :], count)
+        g, lengths = columns(first[len(self.links) * per :], count), {}
         for i, link in enumerate(self.links):
             block = columns(first[i * per : (i + 1) * per], count)
             r, dr = block[:, :3], block[:, 3:].reshape(count, 3, m)
-            d = np.sqrt((r * r).sum(axis=1))
+            d = lengths[link.name] = np.sqrt((r * r).sum(axis=1))
             w = np.full(count, link.k) if link.L0 is None else link.k * (1 - link.L0 / d)
             if link.cable and link.L0 is not None:
                 P[:, self.k_slots[link.name]] *= d > link.L0
                 w = np.where(d > link.L0, w, 0.0)
             g += w[:, None] * np.einsum("nc,ncj->nj", r, dr)
-        return g, X[:, self.coords], P, dirs
+        return g, X[:, self.coords], P, dirs, lengths
 
     def positions(self, x: np.ndarray) -> np.ndarray:
         """Node coordinates (R, 3 per node) at points (R, n chart angles)."""
@@ -320,14 +320,12 @@ class SphereFramework:
         """The critical points (chart angles), each pose once, as endpoints of their taut
         sets' systems (node coordinates, each link's d and w, each bar's multiplier)."""
         roots = self.fresh(roots, np.zeros((0, self.n)))
-        X = self.positions(roots)
-        d = self._lengths(X)
+        grad, X, _, _, d = self._numeric(roots)
         taut = np.ones((len(roots), len(self.cables)), dtype=bool)
         for j, c in enumerate(self.cables):
             x = next((y for y in self.links if y.name == c), None)
             if x is not None and x.L0 is not None:
                 taut[:, j] = d[c] >= x.L0
-        grad = self._numeric(roots)[0]
         out = {}
         for key in {tuple(row) for row in taut}:
             rows = np.flatnonzero((taut == np.array(key)).all(axis=1))
@@ -336,15 +334,6 @@ class SphereFramework:
             out[names] = self._endpoints(fs, X[rows], {k: v[rows] for k, v in d.items()},
                                          grad[rows])  # fmt: skip
         return out
-
-    def _lengths(self, X: np.ndarray) -> dict[str, np.ndarray]:
-        """Each spring's and cable's length at poses X (R, node coordinates)."""
-        full = np.zeros((len(X), len(self.full.ps.variables)))
-        full[:, self.coords] = X
-        first = self.full.numeric.first_order(full, np.asarray(self.P))
-        per = 3 + 3 * len(self.coords)
-        return {x.name: np.sqrt((columns(first[i * per : i * per + 3], len(X)) ** 2).sum(axis=1))
-                for i, x in enumerate(self.links)}  # fmt: skip
 
     def bar_gradients(self, X: np.ndarray) -> np.ndarray:
         """(R, bars, node coordinates): the gradient of each bar's (|r|^2 - length^2) / 2."""

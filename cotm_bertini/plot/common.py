@@ -169,3 +169,10 @@ def physical_rows(solutions: pd.DataFrame) -> pd.DataFrame:
     if len(solutions) == 0 or "physical" not in solutions:
         return solutions.iloc[0:0]
     return solutions[solutions["physical"].astype(bool)]
+
+
+def cube(limits: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    """Axis limits widened to a cube around their middle: one scale on every axis of a 3-D
+    panel (a flat pose stays flat, not blown up to its round-off)."""
+    half = max(hi - lo for lo, hi in limits) / 2
+    return [((lo + hi) / 2 - half, (lo + hi) / 2 + half) for lo, hi in limits]

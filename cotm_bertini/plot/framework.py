@@ -10,7 +10,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from ..model.framework.spec import Framework, owner
-from .common import physical_rows, save, set_title, values_line
+from .common import cube, physical_rows, save, set_title, values_line
 
 _AXES = "xyz"
 _STYLE = {
@@ -103,6 +103,10 @@ def framework_figure(fw: Framework, solutions: pd.DataFrame) -> Figure:
         _draw(ax, fw, row)
         if fw.dim == 2:
             ax.set_aspect("equal", adjustable="datalim")
+        else:
+            for a, lim in zip("xyz", cube([getattr(ax, f"get_{a}lim")() for a in "xyz"]),
+                              strict=True):  # fmt: skip
+                getattr(ax, f"set_{a}lim")(lim)
         mark = "stable" if bool(row["stable"]) else str(row["kind"])
         set_title(ax, f"#{int(row['solution_id'])}: {mark}, V = {row['energy']:.4g}", fontsize=9)
         ax.tick_params(labelsize=7)

@@ -13,7 +13,7 @@ from matplotlib.figure import Figure
 
 from ..fs import atomic_write_bytes
 from ..params import Params
-from .common import param_label, save, set_title, values_line
+from .common import cube, param_label, save, set_title, values_line
 from .configurations import _THIN, _draw_mechanism, configuration_points
 
 SNAP_BACKGROUND = "#fff0f0"  # a frame on either side of a snap
@@ -93,9 +93,8 @@ def animate_move(move, path: str | Path, frames: int = 80) -> Path:
     for k in pick:  # a first pass over every frame: one view for all of them
         _frame(ax, move, table.iloc[k])
     limits = [getattr(ax, f"get_{a}lim")() for a in "xyz"[: 3 if kw else 2]]
-    if kw:  # a cube around the data: one scale on every axis (a flat pose stays flat)
-        half = max(hi - lo for lo, hi in limits) / 2
-        limits = [((lo + hi) / 2 - half, (lo + hi) / 2 + half) for lo, hi in limits]
+    if kw:
+        limits = cube(limits)
     images = []
     for k in pick:
         ax.clear()

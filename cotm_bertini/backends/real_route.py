@@ -62,6 +62,12 @@ def landscape(fw: Framework) -> TorusFramework | SphereFramework:
     """V over boxes of the framework's configuration space (covers says which), built once a
     process: a worker searching several shares of its boxes (backends.box_shares) rebuilds it
     once, and the solve that dealt them not again."""
+    return new_landscape(fw)
+
+
+def new_landscape(fw: Framework) -> TorusFramework | SphereFramework:
+    """The landscape of `fw`, built now (uncached: continuation in chart angles builds one for
+    each parameter value it visits, continuation/charts.py)."""
     return SphereFramework(fw) if fw.dim == 3 else TorusFramework(fw)
 
 
@@ -242,6 +248,10 @@ class TorusFramework:
         lengths there (a start for Newton on one smooth piece of V, followed past a switch)."""
         fs = framework_system(self.fw, taut)
         return self._endpoints(fs, angles, self._lengths(angles), np.arange(len(angles)))
+
+    def cable_lengths(self, x: np.ndarray) -> dict[str, np.ndarray]:
+        """Each link's length at points (R, n angles), normalised units as `links`' L0."""
+        return self._lengths(x)
 
     def _lengths(self, angles: np.ndarray) -> dict[str, np.ndarray]:
         dds, _, _ = self.parts(Interval(angles))

@@ -286,6 +286,10 @@ class SphereFramework:
             g += w[:, None] * np.einsum("nc,ncj->nj", r, dr)
         return g, X[:, self.coords], P, dirs, lengths
 
+    def cable_lengths(self, x: np.ndarray) -> dict[str, np.ndarray]:
+        """Each link's length at points (R, n chart angles), normalised units as `links`' L0."""
+        return self._numeric(x)[4]
+
     def positions(self, x: np.ndarray) -> np.ndarray:
         """Node coordinates (R, 3 per node) at points (R, n chart angles)."""
         return np.stack(self.kinematics(x)[0], axis=1)

@@ -26,9 +26,11 @@ class Link:
     cable: bool
 
 
-def links(fw: Framework, active: tuple[str, ...]) -> tuple[Link, ...]:
-    """The springs and cables `active` (as first_order lists them) in normalised units."""
-    slots, zfl = normalized_slots(fw), set(fw.zero_free_length())
+def links(fw: Framework, active: tuple[str, ...], slots: dict | None = None) -> tuple[Link, ...]:
+    """The springs and cables `active` (as first_order lists them) in normalised units (from
+    `slots` where given: the framework's normalised slots)."""
+    slots = normalized_slots(fw) if slots is None else slots
+    zfl = {x.name for x in fw.links if x.kind != "bar" and slots[f"L0_{x.name}"] == 0}
     cables = {c.name for c in fw.cables}
     return tuple(
         Link(x, slots[f"k_{x}"], None if x in zfl else slots[f"L0_{x}"], x in cables)

@@ -71,6 +71,21 @@ def new_landscape(fw: Framework) -> TorusFramework | SphereFramework:
     return SphereFramework(fw) if fw.dim == 3 else TorusFramework(fw)
 
 
+def moved_landscape(land, fw: Framework, slots: dict):
+    """`land` (a torus or spheres landscape) at other parameter values: a copy with the
+    numbers replaced by `slots` (fw's normalised slots; 20x cheaper than a new landscape, for
+    continuation's many values), its taut sets' systems kept; None where a free length is 0 in
+    one and not the other (the structure differs: build one anew)."""
+    for x in fw.links:
+        if x.kind != "bar" and (slots[f"L0_{x.name}"] == 0) != (land.slots[f"L0_{x.name}"] == 0):
+            return None
+    out = copy.copy(land)
+    out.fw = fw
+    out.renumber(slots)
+    out.__dict__.pop("hessian_sets", None)  # which taut sets occur may differ at these values
+    return out
+
+
 class TorusFramework:
     """V of a planar framework pinned in an open chain, over boxes of its body angles."""
 
@@ -79,17 +94,21 @@ class TorusFramework:
         if why:
             raise ValueError(f"the real route does not cover {fw.name}: {why}")
         self.fw = fw
-        slots = normalized_slots(fw)
-        self.P = [float(v) for v in slot_vector(slots)]
         self.cables = tuple(c.name for c in fw.cables)
         self.full = framework_system(fw, self.cables)
         self.n = self.full.local_size
         self.bodies = layout(fw).rotations
-        self.links = links(fw, self.full.active)
+        self.renumber()
         self.free_springs = [i for i, x in enumerate(self.links) if x.L0 is not None
                              and not x.cable]  # fmt: skip
         self.member: np.ndarray | None = None  # a family's view: each box's member (rows)
         self.family: TorusFamily | None = None
+
+    def renumber(self, slots: dict | None = None) -> None:
+        """The numbers taken from normalised `slots` (default: the framework's)."""
+        self.slots = normalized_slots(self.fw) if slots is None else slots
+        self.P = [float(v) for v in slot_vector(self.slots)]
+        self.links = links(self.fw, self.full.active, self.slots)
 
     def structure(self) -> tuple:
         """What a search's arithmetic depends on besides the numbers: frameworks of one
@@ -208,8 +227,9 @@ class TorusFramework:
                 w = np.where(on, w, 0.0)
             grad += w[:, None] * a
         hess = np.zeros((len(x), m, m))
-        for taut_set, fs in self.hessian_sets:
-            want = np.array([c in taut_set for c in self.cables], dtype=bool)
+        for want in np.unique(taut, axis=0):  # each taut set present (any: values may move)
+            fs = framework_system(self.fw, tuple(c for c, on in zip(self.cables, want,
+                                                                    strict=True) if on))  # fmt: skip
             rows = np.flatnonzero((taut == want).all(axis=1))
             if len(rows):
                 h = fs.numeric.hessian(self._numeric_pose(fs, x[rows]), P if P.ndim == 1 else

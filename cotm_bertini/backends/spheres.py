@@ -98,14 +98,12 @@ class SphereFramework:
         if why:
             raise ValueError(f"the real route does not cover {fw.name}: {why}")
         self.fw = fw
-        self.slots = normalized_slots(fw)
-        self.P = [float(v) for v in slot_vector(self.slots)]
         self.cables = tuple(c.name for c in fw.cables)
         self.full = framework_system(fw, self.cables)
-        self.links = links(fw, self.full.active)
+        self.chain = chain
         self.nodes = tuple(n for n, _, _ in chain)
         self.parent = {n: top for n, top, _ in chain}
-        self.length = {n: self.slots[f"len_{bar}"] for n, _, bar in chain}
+        self.renumber()
         self.n = 2 * len(self.nodes)
         self.bodies = ()  # no body angles (point.along_continua)
         names = list(self.full.ps.variables)
@@ -114,6 +112,14 @@ class SphereFramework:
         if self.coords != list(range(self.full.local_size)):
             raise ValueError(f"{fw.name}: node coordinates are not the local coordinates")
         self.k_slots = {c: list(self.slots).index(f"k_{c}") for c in self.cables}
+
+    def renumber(self, slots: dict | None = None) -> None:
+        """The numbers taken from normalised `slots` (default: the framework's): the
+        generated code's parameters, links, bar lengths."""
+        self.slots = normalized_slots(self.fw) if slots is None else slots
+        self.P = [float(v) for v in slot_vector(self.slots)]
+        self.links = links(self.fw, self.full.active, self.slots)
+        self.length = {n: self.slots[f"len_{bar}"] for n, _, bar in self.chain}
 
     @cached_property
     def hessian_sets(self) -> list[tuple[tuple[str, ...], FrameworkSystem]]:

@@ -19,13 +19,15 @@ cable at its free length).
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..backends.real_route import new_landscape
-from ..model.framework.spec import Framework
+from ..backends.real_route import moved_landscape, new_landscape
+from ..model.framework.spec import Framework, scale_of, slot_kind
+from ..model.framework.units import units
 
 FD = 1e-6  # central differences in a parameter: step FD * (1 + |p|)
 FD_ANGLE = 1e-5  # ... in a chart angle (rad), for the fold function's gradient
@@ -42,26 +44,45 @@ class ChartPlane:
     def __init__(self, fw: Framework, x: str, y: str):
         self.fw, self.x, self.y = fw, x, y
         self._lands: dict[tuple[float, float], object] = {}
-        first = self.land((fw.values[x], fw.values[y]))
+        self._base = None
+        first = self._base = self.land((fw.values[x], fw.values[y]))
+        self._exprs = fw.slot_expressions()
+        length, stiffness = units(fw)
+        self._scale = {n: scale_of(slot_kind(n), length, stiffness) for n in self._exprs}
         self.n = first.n
         self.cables = tuple(c.name for c in fw.cables)
         self.rechart: Callable = getattr(first, "rechart", lambda t: t)
 
     def land(self, p) -> object:
-        """The landscape at parameter values p = (x, y), built once."""
+        """The landscape at parameter values p = (x, y), made once (from the first one)."""
         key = (float(p[0]), float(p[1]))
         got = self._lands.get(key)
         if got is None:
             if len(self._lands) >= KEEP:
                 self._lands.clear()
-            got = self._lands[key] = new_landscape(
-                self.fw.replace(**{self.x: key[0], self.y: key[1]})
-            )
+            # Unvalidated values: the map's grid was validated, and what continuation visits
+            # between grid points (Newton's iterates, difference steps) need not be. The slots
+            # in the first landscape's units (a unit that moved with the parameters would put
+            # its own derivative into the differences).
+            values = {**self.fw.values, self.x: key[0], self.y: key[1]}
+            fw = dataclasses.replace(self.fw, parameters=tuple(values.items()))
+            got = None
+            if self._base is not None:
+                slots = {n: e.evaluate(values) / self._scale[n] for n, e in self._exprs.items()}
+                got = moved_landscape(self._base, fw, slots)
+            got = new_landscape(fw) if got is None else got
+            self._lands[key] = got
         return got
 
     def derivatives(self, theta: np.ndarray, p) -> tuple[np.ndarray, np.ndarray]:
         """grad V (R, n) and its Hessian (R, n, n) at chart points theta (R, n), parameters p."""
         return self.land(p).derivatives(np.atleast_2d(theta))
+
+    def grad_along(self, theta: np.ndarray, p, d: np.ndarray) -> np.ndarray:
+        """d grad V / dt along p + t d at chart points theta (R, n): central differences."""
+        h = FD * (1.0 + float(np.abs(p).max()))
+        up, down = np.asarray(p) + h * d, np.asarray(p) - h * d
+        return (self.derivatives(theta, up)[0] - self.derivatives(theta, down)[0]) / (2 * h)
 
     def grad_p(self, theta: np.ndarray, p) -> np.ndarray:
         """d grad V / d(x, y) at chart points theta (R, n): (R, n, 2), central differences."""
@@ -133,7 +154,7 @@ def _one_step(plane: ChartPlane, theta, p0, p1) -> tuple[np.ndarray, np.ndarray]
     the index is kept and the corrector stayed within half the predictor's move (no jump)."""
     dp = np.asarray(p1, float) - np.asarray(p0, float)
     _, H = plane.derivatives(theta, p0)
-    gp = plane.grad_p(theta, p0) @ dp
+    gp = plane.grad_along(theta, p0, dp)
     with np.errstate(all="ignore"):
         try:
             move = -np.linalg.solve(H, gp[..., None])[..., 0]

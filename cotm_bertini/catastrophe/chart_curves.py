@@ -18,7 +18,8 @@ chart, and the next starts at that point recharted, in the same direction (the p
 decides). A piece also stops where the taut set changes (a fold of one taut set ends on a switch;
 a switch curve ends where another cable switches). Cusps are where a fold curve's image in the
 plane turns back (framework_folds._cusps), confirmed by the vanishing of the cubic term
-v . (d/de H(theta + e v)) v / |d/de H v| (v the unit null vector of the symmetric H).
+v . (d/de H(theta + e v)) v (v the unit null vector of the symmetric H; normalised units,
+relative to the largest entry of H when that is above 1).
 """
 
 from __future__ import annotations
@@ -43,7 +44,8 @@ SPACING = 0.01  # consecutive points: at most this fraction of the window's diag
 HMAX = 0.05  # largest step in z (rad and the parameters' units)
 MAX_PIECES = 400  # pieces of one curve's end (a curve along a chart edge changes chart often)
 ON_CURVE = 3  # a seed within this many spacings (plane) and HMAX steps (pose) of a curve is on it
-CUSP_TOL = 1e-4  # |v . H_e v| / |H_e v| below this confirms a cusp (a fold's is of order one)
+CUSP_TOL = 1e-6  # |v . H_e v| / max(1, |H|) below this confirms a cusp (normalised units)
+CUSP_HALVINGS = 32  # bisections refining a cusp: its bracket (two steps) to 1e-10 of it
 NUDGE = 1e-7  # a switch's sides: this far (normalised length) into each
 
 
@@ -99,9 +101,11 @@ def fold_equations(plane: ChartPlane) -> Equations:
 
 
 def _jet(plane: ChartPlane, theta: np.ndarray, p) -> tuple:
-    """At one chart point: grad V (n,), H (n, n), d grad / d(x, y) (n, 2) and dH/dz (n + 2, n, n)
-    by central differences (the angles' shifts in one call; the parameters' steps those of
-    plane.grad_p, so their landscapes are shared)."""
+    """At one chart point: grad V (n,), H (n, n), d grad / d(x, y) (n, 2) and dH/dz (n + 2, n, n):
+    central differences in the angles (their shifts in one call), forward differences in the
+    parameters (step charts.FD * (1 + |p|): a landscape is built for each parameter value, the
+    dearest part of an evaluation; the Jacobian's O(FD) error leaves Newton's fixed point, F = 0,
+    as it is)."""
     n = plane.n
     shifts = np.vstack([theta, theta + FD_ANGLE * np.eye(n), theta - FD_ANGLE * np.eye(n)])
     g, H = plane.derivatives(shifts, p)
@@ -110,11 +114,11 @@ def _jet(plane: ChartPlane, theta: np.ndarray, p) -> tuple:
     gp = np.empty((n, 2))
     for k in range(2):
         h = FD * (1.0 + abs(p[k]))
-        up, down = list(p), list(p)
-        up[k], down[k] = p[k] + h, p[k] - h
-        (gu, Hu), (gd, Hd) = plane.derivatives(theta, up), plane.derivatives(theta, down)
-        gp[:, k] = (gu[0] - gd[0]) / (2 * h)
-        dH[n + k] = (Hu[0] - Hd[0]) / (2 * h)
+        up = list(p)
+        up[k] = p[k] + h
+        gu, Hu = plane.derivatives(theta, up)
+        gp[:, k] = (gu[0] - g[0]) / h
+        dH[n + k] = (Hu[0] - H[0]) / h
     return g[0], H[0], gp, dH
 
 
@@ -340,7 +344,7 @@ def _rows(plane: ChartPlane, curves: list[_Curve], win: Window) -> tuple[pd.Data
                          "kind": kind})  # fmt: skip
         offset = 0
         for seg in curve.segments if kind == "fold" else []:
-            for k, z in _cusps(curve.eqs, seg, win):
+            for k, z in _cusps(curve.eqs, seg, win, CUSP_HALVINGS):
                 row = _point(plane, z, curve.seed, about)
                 if row["null_cubic"] <= CUSP_TOL:
                     about["cusps"] += 1
@@ -399,8 +403,7 @@ def _fold_stability(plane: ChartPlane, z: np.ndarray) -> tuple[bool, float]:
     k = int(np.argmin(np.abs(eig)))
     v = vec[:, k]
     _, Hs = plane.derivatives(np.stack([z[:n] + FD_ANGLE * v, z[:n] - FD_ANGLE * v]), z[n:])
-    q = (Hs[0] - Hs[1]) @ v / (2 * FD_ANGLE)
-    cubic = float(abs(v @ q) / max(float(np.linalg.norm(q)), 1e-300))
+    cubic = float(abs(v @ (Hs[0] - Hs[1]) @ v) / (2 * FD_ANGLE) / max(1.0, np.abs(H).max()))
     return bool((np.delete(eig, k) < 0).sum() == 0), cubic
 
 

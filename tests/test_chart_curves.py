@@ -22,6 +22,7 @@ from cotm_bertini.catastrophe.curve_trace import Window, newton, tangent, trace
 from cotm_bertini.catastrophe.fold_sweep import curve_equations, long_enough
 from cotm_bertini.catastrophe.framework_folds import framework_fold_curves
 from cotm_bertini.continuation.charts import ChartPlane, advance
+from cotm_bertini.continuation.charts import newton as chart_newton
 from cotm_bertini.errors import ParameterError
 from cotm_bertini.model.framework.folds import curve_system
 
@@ -199,3 +200,53 @@ def test_sphere_folds_change_chart_and_are_singular_equilibria_of_the_statics():
         k = np.argmin(np.abs(ev))
         assert abs(ev[k]) < 1e-6 * np.abs(ev).max()
         assert bool(row["changes_stable_count"]) == bool((np.delete(ev, k) >= 0).all())
+
+
+def _prism_reference(L0t: float, h: float) -> tp.Spatial:
+    """examples/prism_slack.toml as the plain-numpy statics see it, at (L0t, h)."""
+    s = np.sqrt(3) / 2
+    anchors = {"ground.a": [1.0, 0.0, 0.0], "ground.b": [-0.5, s, 0.0],
+               "ground.c": [-0.5, -s, 0.0]}  # fmt: skip
+    bars = tuple((f"ground.{g}", n, h) for g, n in zip("abc", "ABC", strict=True))
+    tops = [(f"top_{a}{b}".lower(), a, b, 1.0, L0t) for a, b in ("AB", "BC", "CA")]
+    diagonals = [(f"diag_{n}".lower(), n, f"ground.{g}", 1.5, 0.4)
+                 for n, g in zip("ABC", "bca", strict=True)]  # fmt: skip
+    return tp.Spatial(anchors, ("A", "B", "C"), bars, tuple(tops + diagonals))
+
+
+def _tangent_index(ref: tp.Spatial, X: np.ndarray, taut: tuple) -> int:
+    """Negative eigenvalues of the taut set's Lagrangian Hessian on the bars' tangent space."""
+    _, _, H, A = tp.newton(ref, X, taut, steps=0)
+    null = np.linalg.svd(A[0])[2][len(ref.bars) :].T
+    return int((np.linalg.eigvalsh(null.T @ H[0] @ null) < 0).sum())
+
+
+def test_prism_switch_curve_is_where_the_statics_put_a_cable_at_its_free_length():
+    """prism_slack over (L0t, h): a flat saddle of index 4 (Newton from a rounded start at
+    the file's values) followed down h until top_ab goes slack seeds that cable's switch curve;
+    at its points the plain-numpy statics find an equilibrium with top_ab at its free length,
+    and changes_stable_count is their Morse indices' on the two sides."""
+    fw = cb.Framework.from_toml(ROOT / "examples" / "prism_slack.toml")
+    plane = ChartPlane(fw, "L0t", "h")
+    theta, ok = chart_newton(plane, np.array([[1.571, 2.97, 1.571, 1.479, 1.571, 4.118]]),
+                             (1.7, 1.2))  # fmt: skip
+    assert ok[0]
+    got = advance(plane, theta, (1.7, 1.2), (1.7, 0.96))  # top_ab slack from h = 0.97
+    assert got.ok[0] and plane.margins(got.points, (1.7, 0.96))[0, 0] < 0
+    seed = Seed("cable_switch", np.concatenate([got.points[0], [1.7, 0.96]]), "top_ab")
+    table, record = chart_fold_curves(plane, [seed], (1.0, 2.4), (0.9, 1.6))
+    assert record["curves"][0]["ends"] == ["edge", "edge"] and not record["warnings"]
+    assert len(table) > 20 and (table["kind"] == "cable_switch").all()
+    for _, row in table.iloc[:: len(table) // 8].iterrows():
+        ref = _prism_reference(row.L0t, row.h)
+        X0 = row[[f"{n}.{c}" for n in "ABC" for c in "xyz"]].to_numpy(float)[None]
+        X, residual, _, _ = tp.newton(ref, X0, None, steps=4)
+        assert residual[0] < 1e-9 and np.abs(X - X0).max() < 1e-6
+        lengths = dict(zip((c[0] for c in ref.cables), ref.lengths(X)[0], strict=True))
+        assert abs(lengths["top_ab"] - row.L0t) < 1e-7
+        free = {c[0]: c[4] for c in ref.cables}
+        both = tuple(sorted(c for c, d in lengths.items() if d > free[c] or c == "top_ab"))
+        slack = tuple(c for c in both if c != "top_ab")
+        changes = _tangent_index(ref, X, both) == 0 and _tangent_index(ref, X, slack) >= 1
+        assert bool(row["changes_stable_count"]) == changes
+        assert row["taut"] == " ".join(both)

@@ -121,7 +121,9 @@ FRAMEWORK_FOLDS = {
     "taut": "the taut set of cables whose system the point solves (none: no cable taut)",
     "null_cubic": "fold and cusp rows: |w . F_XX[v, v]| / |F_XX[v, v]| (v, w the unit right and "
     "left null vectors of the equilibrium Jacobian J_X F, F_XX[v, v] by central differences): "
-    "the energy's cubic term along the null direction, 0 at a cusp; empty at cable switches",
+    "the energy's cubic term along the null direction, 0 at a cusp; empty at cable switches. "
+    "Curves traced in chart angles (frameworks on the real route): |v . (d/de H(theta + e v)) "
+    "v| / max(1, |H|), H the Hessian in chart angles, v its unit null vector",
 }
 
 FRAMEWORK_REGIONS = {

@@ -205,6 +205,14 @@ def trace(eqs: Equations, z0: np.ndarray, win: Window, spacing: float = 0.002,
     return Traced(np.array(pts), False, (end_b, end_f))
 
 
+def one_way(eqs: Equations, z0: np.ndarray, t0: np.ndarray, win: Window, spacing: float = 0.002,
+            hmax: float = 0.05, keep: Keep = None) -> tuple[np.ndarray, str]:  # fmt: skip
+    """trace's one direction: the points from z0 (excluded) along +t0, (m, N), and how that end
+    stopped (Traced.ends); for a caller that goes on from an end (a curve traced in pieces)."""
+    pts, end = _one_way(eqs, z0, t0, win, spacing, hmax, keep, False)
+    return np.array(pts).reshape(-1, len(z0)), end
+
+
 def turning_point(eqs: Equations, za: np.ndarray, zb: np.ndarray, direction: np.ndarray,
                   win: Window, halvings: int = 50) -> np.ndarray | None:  # fmt: skip
     """The point of the curve between za and zb (near each other on it) where its image in the

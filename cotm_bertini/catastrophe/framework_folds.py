@@ -481,8 +481,9 @@ def _runs(keep: np.ndarray) -> list[np.ndarray]:
     return [p for p in parts if len(p) > 1]
 
 
-def _cusps(eqs, pts: np.ndarray, win: Window) -> list[tuple[int, np.ndarray]]:
-    """(index, refined point) of each cusp of a polyline: where its image turns back."""
+def _cusps(eqs, pts: np.ndarray, win: Window, halvings: int = 50) -> list[tuple[int, np.ndarray]]:
+    """(index, refined point) of each cusp of a polyline: where its image turns back (refined
+    by `halvings` bisections, curve_trace.turning_point)."""
     xy = np.stack([pts[:, win.ix] * win.scale[0], pts[:, win.iy] * win.scale[1]], axis=1)
     seg = np.diff(xy, axis=0)
     norm = np.linalg.norm(seg, axis=1)
@@ -490,7 +491,7 @@ def _cusps(eqs, pts: np.ndarray, win: Window) -> list[tuple[int, np.ndarray]]:
     while k < len(seg) - 1:
         a, b = seg[k], seg[k + 1]
         if norm[k] > 0 and norm[k + 1] > 0 and a @ b < TURN_COS * norm[k] * norm[k + 1]:
-            z = turning_point(eqs, pts[k], pts[k + 2], a / norm[k], win)
+            z = turning_point(eqs, pts[k], pts[k + 2], a / norm[k], win, halvings)
             if z is not None:
                 out.append((k + 1, z))
             k += 2

@@ -6,7 +6,9 @@ characteristic 2^nodes, the status. Usage: python bench/spatial_route.py [--only
 [--workers N | --dask N] [--budget NAME=SECONDS ...] (defaults: prism_slack 600 s, prism4
 900 s, tower 600 s; a solve stopped by its budget is `incomplete` and says how much is left;
 --dask N starts a local Dask cluster of N one-thread worker processes and solves on it with
---scheduler: boxes a second against N, the scale-out a cluster of machines would give)."""
+--scheduler: boxes a second against N, the scale-out a cluster of machines would give).
+--map: instead, prism_slack's 41 x 41 map over (L0t, h) in the window L0t 0.2..0.8, h 1.2..1.6
+on the command line (fresh cache, --workers, default 2): its stages' times and its checks."""
 
 from __future__ import annotations
 
@@ -71,6 +73,35 @@ def _solve(name: str, budget: float, workers: int, scheduler: str = "") -> dict:
     }
 
 
+MAP = ["--param", "L0t", "--from", "0.2", "--to", "0.8", "--param2", "h", "--from2", "1.2",
+       "--to2", "1.6", "--points", "41"]  # fmt: skip
+
+
+def _map(workers: int) -> dict:
+    """prism_slack's 41 x 41 map (fresh cache) on the command line and its run.json's figures."""
+    cli = str(Path(sys.executable).with_name("cotm-bertini"))
+    out = Path(tempfile.mkdtemp(prefix="cotm-bench-spatial-map-"))
+    env = {**os.environ, "COTM_CACHE": str(out / "cache")}
+    args = [cli, "map", "--framework", str(ROOT / "examples" / "prism_slack.toml"), *MAP,
+            "--workers", str(workers), "--out", str(out / "runs"), "--no-plots",
+            "--quiet"]  # fmt: skip
+    t0 = time.perf_counter()
+    done = subprocess.run(args, env=env, capture_output=True, text=True)
+    wall = time.perf_counter() - t0
+    if done.returncode not in (0, 5):
+        raise SystemExit(f"map: exit {done.returncode}\n{done.stderr[-2000:]}")
+    record = json.loads((out / "runs" / "latest" / "run.json").read_text())
+    chart = record["chart"]
+    return {
+        "map": "prism_slack 41 x 41", "workers": workers, "wall_s": wall,
+        **{f"{k}_s": v for k, v in chart["timings"].items()},
+        "anchors_proved": chart["anchors_proved"], "lost": chart["propagation"]["lost_branches"],
+        "morse_failed": chart["morse_failed"], "curves": record["fold_curves"],
+        "count_changes": record["count_changes"], "unexplained": record["unexplained_changes"],
+        "status": record["status"],
+    }  # fmt: skip
+
+
 def main() -> None:
     """Solve each example within its budget; print and keep the table."""
     ap = argparse.ArgumentParser(description=__doc__)
@@ -78,7 +109,13 @@ def main() -> None:
     ap.add_argument("--workers", type=int, default=1)
     ap.add_argument("--dask", type=int, default=0, metavar="N")
     ap.add_argument("--budget", nargs="*", default=[], metavar="NAME=SECONDS")
+    ap.add_argument("--map", action="store_true")
     args = ap.parse_args()
+    if args.map:
+        frame = pd.DataFrame([_map(args.workers if args.workers > 1 else 2)])
+        show("prism_slack's map by continuation in chart angles", frame, {})
+        write_csv(frame, "spatial_map")
+        return
     budgets = dict(BUDGETS)
     for item in args.budget:
         name, _, seconds = item.partition("=")

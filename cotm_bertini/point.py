@@ -516,6 +516,16 @@ def _real_parts(fw, sets: list, groups: dict, report: dict, unit, tolerances) ->
     return parts
 
 
+def real_table(fw, groups: dict, tolerances: Tolerances) -> dict:
+    """The rows (analysis.framework_checks.order_rows) of the real route's endpoints `groups`
+    ({taut set: Endpoints}, a landscape's `endpoints`), classified as a solve's are."""
+    from .analysis.framework_checks import order_rows
+    from .model.framework.units import units
+
+    parts = _real_parts(fw, [], groups, {}, units(fw), tolerances)
+    return order_rows(fw, [p[0] for p in parts])
+
+
 def along_continua(land, found, continua: list) -> int:
     """How many of the search's undecided boxes lie along a traced continuum: within the
     largest step between its traced points (in the body angles) of one of them."""

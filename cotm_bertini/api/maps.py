@@ -96,13 +96,17 @@ def design_map(
     progress: bool = False,
     l01: tuple[float, float] | None = None,
     l02: tuple[float, float] | None = None,
+    grid: str = "auto",
 ) -> DesignMap:
     """Fold curves in the window, and the number of physical and stable equilibria on a
     points x points grid of it (by a 2-D sweep: parameter homotopies).
 
     A framework: design_map(fw, "x", (-0.6, 0.8), "y", (-0.8, 0.2), points=101), any two of
     its parameters. The paper's mechanism: design_map(params, l01=(0, 14), l02=(0, 14),
-    points=101) (or positionally design_map(params, (0, 14), (0, 14), 101))."""
+    points=101) (or positionally design_map(params, (0, 14), (0, 14), 101)). `grid`: "search"
+    (every grid point solved: a 2-D sweep), "continuation" (a framework on the real route:
+    anchors searched, equilibria followed in chart angles, catastrophe/chart_map.py), or
+    "auto" (continuation for a product of spheres, whose fold systems sympy cannot expand)."""
     from ..backends.pools import check_workers
     from ..continuation.spec import check_grid
     from ..point import check_route
@@ -116,10 +120,13 @@ def design_map(
     check_grid(model, x, tuple(map(float, xs)), y, tuple(map(float, ys)))  # every point too
     check_workers(workers)  # before any process starts
     check_route(model, settings or Settings(), "map")
-    key = _map_key(model, (x, xr), (y, yr), points, settings)
+    grid = grid_route(model, grid, settings or Settings())
+    key = _map_key(model, (x, xr), (y, yr), points, settings, grid)
     made = _made_before(model, key, (x, y))
     if made is not None:
         return made
+    if grid == "continuation":
+        return _chart_design_map(model, (x, xr, xs), (y, yr, ys), settings, workers, key)
     t0 = time.perf_counter()
     say(f"map: fold curves in the window {x} {xr[0]:g}..{xr[1]:g}, {y} {yr[0]:g}..{yr[1]:g}")
     job = (model, x, xr, y, yr, settings, workers)
@@ -163,12 +170,75 @@ def design_map(
     return DesignMap(model, folds, regions, record, (x, y))
 
 
-def _map_key(model, xa: tuple, ya: tuple, points: int, settings: Settings | None) -> str:
+GRIDS = ("auto", "search", "continuation")
+
+
+def grid_route(model, grid: str, settings: Settings) -> str:
+    """How the map's grid is made ("search" or "continuation"), or a one-line refusal."""
+    from ..backends.real_route import covers
+    from ..errors import ParameterError
+    from ..point import framework_route
+
+    if grid not in GRIDS:
+        raise ParameterError(f"grid = {grid!r}: not a grid route ({', '.join(GRIDS)})")
+    real = not isinstance(model, Params) and framework_route(model, settings) == "real"
+    if grid == "continuation" and not real:
+        raise ParameterError("grid = 'continuation': only for a framework on the real route "
+                             "(a torus of body angles or a product of spheres)")  # fmt: skip
+    if grid == "auto":
+        return "continuation" if real and covers(model) == "" and model.dim == 3 else "search"
+    return grid
+
+
+def _chart_design_map(model, xa: tuple, ya: tuple, settings, workers: int, key: str):
+    """design_map by continuation in chart angles (catastrophe/chart_map.py): its grid rows
+    written as a 2-D sweep's table (sweep.csv) in the cache, the map's record with the
+    completeness test; status incomplete where a grid point was not searched."""
+    from ..catastrophe.chart_map import chart_map
+    from ..fs import cache_root
+
+    (x, xr, xs), (y, yr, ys) = xa, ya
+    t0 = time.perf_counter()
+    say(f"map: {x} {xr[0]:g}..{xr[1]:g}, {y} {yr[0]:g}..{yr[1]:g} by continuation in chart angles")
+    cm = chart_map(model, x, xs, y, ys, settings or Settings(), workers)
+    table = cm.table
+    regions = counts_on_grid({c: table[c].to_numpy() for c in ("point", "physical", "stable")},
+                             xs, ys, (x, y))  # fmt: skip
+    folder = cache_root() / "chart_maps" / key
+    if folder.exists():  # an identical map's grid whose entry was lost: made again
+        import shutil
+
+        shutil.rmtree(folder)
+    with new_folder(folder) as work:
+        write_csv(work / "sweep.csv", table)
+    folds = cm.folds
+    proved = cm.record["anchors_proved"] == len(xs) * len(ys)
+    clean = (
+        proved and not cm.record["propagation"]["lost_branches"] and not cm.record["morse_failed"]
+    )
+    record = {
+        "params": model.as_dict(), "window": {x: list(xr), y: list(yr)}, "axes": [x, y],
+        "points": len(xs), "fold_points": len(folds),
+        "fold_curves": int(folds.curve_id[folds.curve_id >= 0].nunique()) if len(folds) else 0,
+        "cusps": int((folds.kind == "cusp").sum()) if len(folds) else 0,
+        "framework": model.name, "sweep_folder": str(folder), "command": sys.argv[:],
+        "sweep_status": "ok" if clean else "incomplete", "chart": cm.record,
+    }  # fmt: skip
+    record.update(explained(regions, folds, (x, y), record["sweep_status"]))
+    record["timings"] = {**cm.record["timings"], "total": time.perf_counter() - t0}
+    record["reused"] = False
+    _keep(key, folds, regions, record)
+    return DesignMap(model, folds, regions, record, (x, y))
+
+
+def _map_key(model, xa: tuple, ya: tuple, points: int, settings: Settings | None,
+             grid: str = "search") -> str:  # fmt: skip
     """What a map depends on (the model, its window and grid, the settings, this package's
     code): two requests with one key make one map (the workers do not change it)."""
     from ..io.cache import request_key
 
-    window = {"axes": [xa[0], ya[0]], "window": [list(xa[1]), list(ya[1])], "points": points}
+    window = {"axes": [xa[0], ya[0]], "window": [list(xa[1]), list(ya[1])], "points": points,
+              **({"grid": grid} if grid != "search" else {})}  # fmt: skip
     settings = (settings or Settings()).as_dict()
     return request_key({**model.key_fields(), "map": window}, settings, {})
 

@@ -228,8 +228,8 @@ class TorusFramework:
             grad += w[:, None] * a
         hess = np.zeros((len(x), m, m))
         for want in np.unique(taut, axis=0):  # each taut set present (any: values may move)
-            fs = framework_system(self.fw, tuple(c for c, on in zip(self.cables, want,
-                                                                    strict=True) if on))  # fmt: skip
+            on = tuple(c for c, t in zip(self.cables, want, strict=True) if t)
+            fs = framework_system(self.fw, on)
             rows = np.flatnonzero((taut == want).all(axis=1))
             if len(rows):
                 h = fs.numeric.hessian(self._numeric_pose(fs, x[rows]), P if P.ndim == 1 else

@@ -194,14 +194,32 @@ def _near(plane: ChartPlane, a: np.ndarray, b: np.ndarray, win: Window, spacing:
     return out
 
 
+CURVE_POINTS = 6.0  # an end of a curve stops after this many points / spacing ("max_points")
+CRAWL_POINTS, CRAWL = 40, 0.05  # ... or after 40 points whose mean step in the plane is below
+# 0.05 of the spacing ("crawls": X-module switch curves moved 1e-4 of the window in 300 points)
+
+
 def _guard(plane: ChartPlane, start: np.ndarray, seed: np.ndarray, cable, win: Window,
-           spacing: float) -> tuple:  # fmt: skip
-    """A piece's `keep` (curve_trace): False where the chart or the taut set changes, or where
-    the curve comes back to its seed after leaving it; and the state that says which, where."""
+           spacing: float, left: int) -> tuple:  # fmt: skip
+    """A piece's `keep` (curve_trace): False where the chart or the taut set changes, where
+    the curve comes back to its seed after leaving it, or after `left` more points (a curve
+    that crawls: a switch along a continuum of the slack side moved 1e-4 of the window in 300
+    points); and the state that says which, where, and how many points it kept."""
     pattern = _taut(plane, start, cable)
-    state: dict = {"why": None, "at": None, "away": False}
+    state: dict = {"why": None, "at": None, "away": False, "kept": 0, "plane": 0.0, "last": start}
 
     def keep(z: np.ndarray) -> bool:
+        state["kept"] += 1
+        state["plane"] += float(win.xy_distance(z, state["last"]))
+        state["last"] = z
+        if state["kept"] > left:
+            state.update(why="max_points", at=z)
+            return False
+        if state["kept"] >= CRAWL_POINTS and (
+            state["plane"] < CRAWL * spacing * win.diagonal * state["kept"]
+        ):  # the pose moves, the parameters hardly: not a curve of the map's plane
+            state.update(why="crawls", at=z)
+            return False
         if _chart_moves(plane, z[: plane.n]):
             state.update(why="chart", at=z)
             return False
@@ -248,9 +266,11 @@ def _trace_on(plane: ChartPlane, eqs: Equations, z0: np.ndarray, t0: np.ndarray,
     (each in one chart; after the first each starts at the point recharted) and how it ended
     (curve_trace's ends, "taut_set", "closed", or "max_pieces")."""
     pieces, z, t, first = [], z0, t0, np.zeros((0, len(z0)))
+    left = int(CURVE_POINTS / spacing)
     for _ in range(MAX_PIECES):
-        keep, state = _guard(plane, z, z0, cable, win, spacing)
+        keep, state = _guard(plane, z, z0, cable, win, spacing, left)
         pts, end = one_way(eqs, z, t, win, spacing, HMAX, keep)
+        left -= state["kept"]
         pieces.append(np.vstack([first, pts]))
         if end != "left":
             return pieces, end
@@ -316,6 +336,10 @@ def chart_fold_curves(plane: ChartPlane, seeds, xrange: tuple[float, float],
     table, about = _rows(plane, curves, win)
     warnings = [f"{counts['seeds_not_refined']} seeds did not converge onto a curve"] * bool(
         counts["seeds_not_refined"]) + about.pop("warnings")  # fmt: skip
+    stops = ("max_points", "stalled", "max_pieces", "crawls")
+    short = sum(end in stops for c in curves for end in c.ends)
+    warnings += [f"{short} curve ends stopped before the window's edge ({', '.join(stops)}: "
+                 "the curve's record)"] * bool(short)  # fmt: skip
     record = {
         "window": {plane.x: list(xrange), plane.y: list(yrange)}, "spacing": spacing,
         "seeds": len(seeds), **counts, "warnings": warnings,

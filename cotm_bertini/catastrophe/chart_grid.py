@@ -25,25 +25,18 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..catastrophe.curve_trace import Window, one_way, tangent, turning_point
 from ..continuation.charts import ChartPlane, advance
 from ..model.framework.spec import Framework
+from .chart_curves import Seed
+from .curve_trace import Window, one_way, tangent, turning_point
 
 ANCHORS = 3  # searched grid points per axis (both ends and the middle)
 SPACING = 0.2  # `through`: steps at most this fraction of the grid step's diagonal
 HMAX = 0.1  # ... and this far in the chart angles (rad)
 SWITCH_TOL = 1e-9  # a cable at its free length within this (normalised units) at a seed
 SECANT_STEPS = 40
+THROUGH_POINTS = 400  # `through` gives up after this many points ("too long")
 TURN_HALVINGS = 24  # a turning point to 2^-24 of a step: a seed, refined by its curve's trace
-
-
-@dataclass(frozen=True)
-class Seed:
-    """A point of a fold or cable-switch curve found on a grid line: z = (chart angles, x, y)."""
-
-    kind: str  # "fold" or "cable_switch"
-    z: np.ndarray
-    cable: str | None = None
 
 
 @dataclass
@@ -170,16 +163,31 @@ def through(plane: ChartPlane, axis: int, p0: np.ndarray, p1: np.ndarray, theta:
     z0 = np.append(theta, t_at)
     t0 = tangent(eqs, z0, z0)
     t0 = t0 if t0[n] >= 0 else -t0
-    pts, end = one_way(eqs, z0, t0, win, SPACING, HMAX, None, False)
+    pts, end = one_way(eqs, z0, t0, win, SPACING, HMAX, _counted(THROUGH_POINTS))
+    end = "too long" if end == "left" else end
     seeds = _turns(plane, eqs, [z0, *pts], win, p0, p1)
-    if end != "edge" or not pts:
-        return end if pts else "stalled", None, seeds
+    if not seeds and len(pts):
+        seeds = _passed(plane, np.vstack([z0, pts]), p0, p1)
+    if end != "edge" or not len(pts):
+        return end if len(pts) else "stalled", None, seeds
     last = pts[-1]
     if abs(last[n] - 1.0) < 1e-9:
         return "far", plane.rechart(last[None, :n])[0], seeds
     if abs(last[n]) < 1e-9:
         return "back", plane.rechart(last[None, :n])[0], seeds
     return "edge", None, seeds
+
+
+def _counted(most: int):
+    """A curve_trace `keep` that stops a trace after `most` points (a branch that wanders
+    without leaving its grid step: a continuum, or a loop)."""
+    seen = [0]
+
+    def keep(z: np.ndarray) -> bool:
+        seen[0] += 1
+        return seen[0] <= most
+
+    return keep
 
 
 def _turns(plane: ChartPlane, eqs, pts: list, win: Window, p0, p1) -> list[Seed]:
@@ -201,6 +209,24 @@ def _turns(plane: ChartPlane, eqs, pts: list, win: Window, p0, p1) -> list[Seed]
             seeds.append(Seed("cable_switch", np.concatenate([theta, p]), plane.cables[at]))
         else:
             seeds.append(Seed("fold", np.concatenate([theta, p])))
+    return seeds
+
+
+def _passed(plane: ChartPlane, pts: np.ndarray, p0, p1) -> list[Seed]:
+    """Where a traced line curve `pts` that did not turn changes its Morse index: H singular
+    with the branch passing (a pitchfork, where a symmetric branch meets the pair its symmetry
+    breaks into, e.g. the prism's flat poses and their mirror images), as a fold seed (the
+    point of the curve nearest singular; the fold system holds there too)."""
+    n = plane.n
+    ps = [p0 + z[n] * (p1 - p0) for z in pts]
+    got = [plane.index(z[None, :n], p) for z, p in zip(pts, ps, strict=True)]
+    index = np.concatenate([i for i, _ in got])
+    near = np.abs(np.concatenate([e for _, e in got]))
+    seeds = []
+    for k in np.flatnonzero(index[1:] != index[:-1]):
+        j = k if near[k] < near[k + 1] else k + 1
+        theta = plane.rechart(pts[j][None, :n])[0]
+        seeds.append(Seed("fold", np.concatenate([theta, ps[j]])))
     return seeds
 
 
@@ -240,28 +266,29 @@ def _switch_point(plane: ChartPlane, theta, p0, p1, col: int, ends) -> Seed | No
 
 
 def anchor_task(task: tuple) -> dict:
-    """One anchor's search (a worker's task): its chart roots and what the search decided."""
-    from ..backends.real_route import critical_seeds, landscape, real_equilibria
+    """One anchor's search (a worker's task: framework, grid index, budget in seconds): its
+    chart roots (and, as the solve does, critical points Newton finds next to cone points or in
+    boxes left undecided) and what the search decided."""
+    from ..backends.box_shares import split_search
+    from ..backends.boxes import MIN_WIDTH, SHORT
+    from ..backends.real_route import critical_seeds, landscape
 
-    fw, key = task
+    fw, key, seconds = task
     t0 = time.perf_counter()
-    _, found = real_equilibria(fw)
+    found = split_search(landscape, fw, SHORT, MIN_WIDTH, max_seconds=seconds,
+                         label=f"anchor search of {fw.name}")  # fmt: skip
     land = landscape(fw)
-    # As the solve does: critical points next to cone points or in undecided boxes, by Newton.
-    seeds = land.fresh(
-        np.vstack(
-            [critical_seeds(land, found.undecided), critical_seeds(land, found.set_aside_boxes)]
-        ),
-        found.roots,
-    )
+    near = [critical_seeds(land, found.undecided), critical_seeds(land, found.set_aside_boxes)]
+    seeds = land.fresh(np.vstack(near), found.roots)
     proved = not len(found.undecided) and not found.budget_hit
-    return {"key": key, "roots": np.vstack([found.roots, seeds]), "proved": proved, "boxes": int(found.boxes),
-            "seconds": time.perf_counter() - t0, "undecided_share": found.undecided_share,
-            "set_aside": int(found.set_aside)}  # fmt: skip
+    return {"key": key, "roots": np.vstack([found.roots, seeds]), "proved": proved,
+            "boxes": int(found.boxes), "seconds": time.perf_counter() - t0,
+            "undecided": found.undecided_share, "set_aside": int(found.set_aside)}  # fmt: skip
 
 
-def anchor_jobs(fw: Framework, x: str, xs, y: str, ys, per_axis: int) -> list[tuple]:
-    """The anchors' tasks: (framework at the grid point, (i, j))."""
-    return [(fw.replace(**{x: float(xs[i]), y: float(ys[j])}), (i, j))
+def anchor_jobs(fw: Framework, x: str, xs, y: str, ys, per_axis: int,
+                seconds: float | None) -> list[tuple]:  # fmt: skip
+    """The anchors' tasks: (framework at the grid point, (i, j), budget)."""
+    return [(fw.replace(**{x: float(xs[i]), y: float(ys[j])}), (i, j), seconds)
             for i in anchor_indices(len(xs), per_axis)
             for j in anchor_indices(len(ys), per_axis)]  # fmt: skip

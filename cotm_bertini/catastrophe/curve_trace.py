@@ -149,7 +149,7 @@ def _clip(eqs: Equations, a: np.ndarray, b: np.ndarray, win: Window) -> np.ndarr
     return None if best is None else best[1]
 
 
-def one_way(eqs: Equations, z0: np.ndarray, t0: np.ndarray, win: Window, spacing: float,
+def _one_way(eqs: Equations, z0: np.ndarray, t0: np.ndarray, win: Window, spacing: float,
              hmax: float, keep: Keep, relative: bool) -> tuple[list[np.ndarray], str]:  # fmt: skip
     """Points from z0 (excluded) along +t0 until the edge, back at z0, back on itself elsewhere
     ("looped": it entered a loop through a junction, which it would go round for ever), out of
@@ -196,11 +196,11 @@ def trace(eqs: Equations, z0: np.ndarray, win: Window, spacing: float = 0.002,
     1 + max |z| if `relative`: a curve running off to infinity leaves in few steps); `keep`: the
     part of z-space to stay in (an end that leaves it stops there, "left")."""
     t0 = tangent(eqs, z0, z0)
-    fwd, end_f = one_way(eqs, z0, t0, win, spacing, hmax, keep, relative)
+    fwd, end_f = _one_way(eqs, z0, t0, win, spacing, hmax, keep, relative)
     if end_f == "closed":
         pts = [z0, *fwd, z0]
         return Traced(np.array(pts), True, ("closed", "closed"))
-    back, end_b = one_way(eqs, z0, -t0, win, spacing, hmax, keep, relative)
+    back, end_b = _one_way(eqs, z0, -t0, win, spacing, hmax, keep, relative)
     pts = [*back[::-1], z0, *fwd]
     return Traced(np.array(pts), False, (end_b, end_f))
 

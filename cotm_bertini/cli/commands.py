@@ -446,7 +446,7 @@ def design_map(args: argparse.Namespace) -> int:
     with silenced(args.quiet):  # --quiet: no progress report from any stage
         found = make_map(
             model, x, xr, y, yr, points=args.points, settings=settings_from(args),
-            workers=workers, progress=not args.quiet,
+            workers=workers, progress=not args.quiet, grid=args.grid,
         )  # fmt: skip
     folder = found.save(new_run_folder(root), plots=not args.no_plots, html=args.html)
     link_latest(root, folder)
@@ -464,6 +464,12 @@ def design_map(args: argparse.Namespace) -> int:
             f"stable-count changes between grid neighbours: {rec['count_changes']}, "
             f"{rec['unexplained_changes']} not explained by a fold curve or cable switch"
         )
+    chart = rec.get("chart")
+    if chart:
+        lost, morse = chart["propagation"]["lost_branches"], chart["morse_failed"]
+        print(f"grid by continuation: {chart['anchors_proved']} of {len(chart['anchors'])} "
+              f"anchors proved; {lost} branches lost; {morse} grid points fail the Morse sum; "
+              f"{chart['not_proved']}")  # fmt: skip
     print(_files_line(folder))
     print(f"the 2-D sweep behind regions.csv: {folder / SWEEP_FOLDER} (sweep.csv, points.bin)")
     if rec.get("unexplained_changes"):

@@ -2,19 +2,13 @@
 backends.spheres) as two of its parameters change: no polynomial system, no sympy expansion.
 
 `ChartPlane` gives grad V, its Hessian and its parameter derivatives at any chart point and any
-(x, y) of the two parameters (a landscape is built for each parameter value visited: 0.2 ms).
-`advance` moves many equilibria at once from one parameter value to the next (an Euler
-predictor on dX/dp = -H^-1 dg/dp, Newton at the new value), halving a step that jumps: the
-Morse index must stay and the corrector stay close to the predictor. What `advance` cannot
-follow, a turning point or a kink at a cable switch, `through` follows by pseudo-arclength on
-the line's equilibrium curve (catastrophe/curve_trace.py): it reaches the far value, or turns
-back at a fold and returns the partner equilibrium.
-
-Equations for curve_trace in z = (chart angles, x, y): `line_equations` (one parameter moving,
-the other fixed), `fold_equations` (grad V = 0 and the minimally augmented fold function s: the
-last entry of the bordered solve [[H, b], [c^T, 0]]^-1 (0, 1), zero exactly where H is singular,
-its gradient -w^T dH v taken by central differences), `switch_equations` (grad V = 0 and a
-cable at its free length).
+(x, y) of the two parameters (a landscape for each parameter value visited, copied from the
+first with its numbers replaced: real_route.moved_landscape). `advance` moves many equilibria at
+once from one parameter value to the next (an Euler predictor on dX/dp = -H^-1 dg/dp, Newton at
+the new value), halving a step that jumps: the Morse index must stay and the corrector stay
+close to the predictor. What `advance` cannot follow (a turning point, a kink at a cable
+switch, a pitchfork) catastrophe/chart_grid.py follows by pseudo-arclength, and the fold and
+switch curves are traced by catastrophe/chart_curves.py.
 """
 
 from __future__ import annotations
@@ -219,29 +213,3 @@ def advance(plane: ChartPlane, theta: np.ndarray, p0, p1) -> Advanced:
                 else:
                     out[i], reached[i] = xi0, f
     return Advanced(out, ok, reached)
-
-
-@dataclass(frozen=True)
-class Line:
-    """A line of the parameter plane: p(t) = origin + t * direction."""
-
-    origin: tuple[float, float]
-    direction: tuple[float, float]
-
-    def at(self, t: float) -> np.ndarray:
-        """The parameters at t."""
-        return np.asarray(self.origin) + t * np.asarray(self.direction)
-
-
-def line_equations(plane: ChartPlane, line: Line):
-    """curve_trace Equations of the equilibria along `line`, z = (chart angles, t)."""
-    n = plane.n
-    d = np.asarray(line.direction, float)
-
-    def eqs(z: np.ndarray, zref: np.ndarray):
-        p = line.at(z[n])
-        g, H = plane.derivatives(z[:n], p)
-        gt = plane.grad_p(z[:n], p)[0] @ d
-        return g[0], np.hstack([H[0], gt[:, None]])
-
-    return eqs

@@ -122,7 +122,7 @@ def test_prism_map_by_continuation_equals_searches_off_the_anchors():
     assert m.record["count_changes"] > 0 and m.record["unexplained_changes"] == 0
     assert m.record["chart"]["morse_failed"] == 0 and (m.folds.kind == "fold").any()
     regions = m.regions.set_index(["L0t", "h"])
-    for L0t, h in ((0.26, 1.56), (0.32, 1.52), (0.5, 1.3), (0.74, 1.56), (0.62, 1.24)):
+    for L0t, h in ((0.26, 1.56), (0.32, 1.52), (0.5, 1.32), (0.74, 1.56), (0.62, 1.24)):
         groups, found = real_equilibria(fw.replace(L0t=L0t, h=h))
         assert not len(found.undecided)
         plane = cm.ChartPlane(fw, "L0t", "h")

@@ -247,8 +247,8 @@ def read_table(path):
     import pandas as pd
 
     table = pd.read_csv(path)
-    for col in ("reason", "kind"):
-        table[col] = table[col].fillna("").astype(str)
+    for col in ("reason", "kind"):  # an all-empty column reads back as float NaN: made text
+        table[col] = table[col].astype(object).fillna("").astype(str)
     table["paths"] = table["paths"].astype(str)
     if "lost_paths" in table:
         table["lost_paths"] = table["lost_paths"].astype("Int64")

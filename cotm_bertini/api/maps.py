@@ -104,9 +104,7 @@ def design_map(
     A framework: design_map(fw, "x", (-0.6, 0.8), "y", (-0.8, 0.2), points=101), any two of
     its parameters. The paper's mechanism: design_map(params, l01=(0, 14), l02=(0, 14),
     points=101) (or positionally design_map(params, (0, 14), (0, 14), 101)). `grid`: "search"
-    (every grid point solved: a 2-D sweep), "continuation" (a framework on the real route:
-    anchors searched, equilibria followed in chart angles, catastrophe/chart_map.py), or
-    "auto" (continuation for a product of spheres, whose fold systems sympy cannot expand)."""
+    (a 2-D sweep), "continuation" (catastrophe/chart_map.py) or "auto" (grid_route)."""
     from ..backends.pools import check_workers
     from ..continuation.spec import check_grid
     from ..point import check_route
@@ -174,7 +172,10 @@ GRIDS = ("auto", "search", "continuation")
 
 
 def grid_route(model, grid: str, settings: Settings) -> str:
-    """How the map's grid is made ("search" or "continuation"), or a one-line refusal."""
+    """How the map's grid is made: "search" (every grid point solved), "continuation" (a
+    framework on the real route: anchors searched, equilibria followed in chart angles), "auto"
+    (continuation for a product of spheres, whose fold systems sympy cannot expand); or a
+    one-line refusal."""
     from ..backends.real_route import covers
     from ..errors import ParameterError
     from ..point import framework_route

@@ -123,7 +123,7 @@ def _step(plane: ChartPlane, state: _State, axis: int, index: int, k: int, sign:
     for row in np.flatnonzero(~moved.ok):
         t_at = moved.reached[row]
         state.throughs += 1
-        end, z, folds = through(plane, axis, p0, p1, moved.points[row], t_at)
+        end, z, folds = through(plane, p0, p1, moved.points[row], t_at)
         state.seeds += folds
         if end == "far":
             arrived.append(z[None, :])
@@ -152,7 +152,7 @@ def _line_eqs(plane: ChartPlane, p0: np.ndarray, p1: np.ndarray):
     return eqs
 
 
-def through(plane: ChartPlane, axis: int, p0: np.ndarray, p1: np.ndarray, theta: np.ndarray,
+def through(plane: ChartPlane, p0: np.ndarray, p1: np.ndarray, theta: np.ndarray,
             t_at: float) -> tuple[str, np.ndarray | None, list]:  # fmt: skip
     """The equilibrium at p0 + t_at (p1 - p0) followed by pseudo-arclength towards p1: ("far",
     its point at p1, seeds), ("back", the point where it came back to p0: the partner of the

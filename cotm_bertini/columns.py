@@ -111,8 +111,11 @@ FRAMEWORK_FOLDS = {
     "arc": "distance along the curve's image in the plane from its first point, in units of the "
     "window's diagonal",
     "kind": "fold (the reduced Hessian singular: two equilibria meet), cusp (where a fold curve's "
-    "image turns back; confirmed by null_cubic), or cable_switch (a taut cable exactly at its "
-    "free length: the equilibrium passes between taut sets)",
+    "image turns back; confirmed by null_cubic), cable_switch (a taut cable exactly at its "
+    "free length: the equilibrium passes between taut sets), or pitchfork (maps by continuation: "
+    "the Hessian singular with the parameters' pull on the equilibria orthogonal to its null "
+    "direction, so the branch passes instead of turning: a symmetric state meets the mirror "
+    "pair it splits into)",
     "physical": "the equilibrium at the point is physical (real, lengths > 0, taut set "
     "consistent); a map keeps only these, inside its window",
     "changes_stable_count": "crossing the curve here changes the number of stable equilibria (a "

@@ -111,16 +111,17 @@ def test_grid_route_is_refused_where_it_cannot_run():
 @pytest.mark.slow
 def test_prism_map_by_continuation_equals_searches_off_the_anchors():
     """prism_slack over (L0t, h) (make stress): its mirror pitchfork (flat poses meeting the
-    pair of mirror minima they break into, 8 against 10 equilibria) explains every change of
-    the stable count; at grid points that are no anchor, on both sides of it, the rows followed
-    equal a proved search of the point (the branch and bound, not the continuation)."""
+    pair of mirror minima they break into, 8 against 10 equilibria), labelled so, explains
+    every change of the stable count; at grid points that are no anchor, on both sides of it,
+    the rows followed equal a proved search of the point (the branch and bound, not the
+    continuation)."""
     from cotm_bertini.backends.real_route import real_equilibria
 
     fw = cb.Framework.from_toml(ROOT / "examples" / "prism_slack.toml")
     m = cb.design_map(fw, "L0t", (0.2, 0.8), "h", (1.2, 1.6), points=11, grid="continuation",
                       workers=2)  # fmt: skip
     assert m.record["count_changes"] > 0 and m.record["unexplained_changes"] == 0
-    assert m.record["chart"]["morse_failed"] == 0 and (m.folds.kind == "fold").any()
+    assert m.record["chart"]["morse_failed"] == 0 and (m.folds.kind == "pitchfork").any()
     regions = m.regions.set_index(["L0t", "h"])
     for L0t, h in ((0.26, 1.56), (0.32, 1.52), (0.5, 1.32), (0.74, 1.56), (0.62, 1.24)):
         groups, found = real_equilibria(fw.replace(L0t=L0t, h=h))
@@ -129,3 +130,23 @@ def test_prism_map_by_continuation_equals_searches_off_the_anchors():
         index, _ = plane.index(found.roots, (L0t, h))
         row = regions.loc[(L0t, h)]
         assert (row.physical, row.stable) == (len(found.roots), int((index == 0).sum()))
+
+
+def test_zeeman_pitchforks_break_the_mirror_and_folds_do_not(zeeman_map):
+    """The spatial Zeeman machine is symmetric in the mirror y -> -y. At a point of the mirror
+    plane labelled pitchfork the independent statics' soft direction (the Hessian on the
+    sphere's tangent plane, its eigenvalue nearest 0) leaves the plane (along y); at one
+    labelled fold it lies in the plane (the plane machine's own fold)."""
+    folds = zeeman_map.folds
+    folds = folds[np.abs(folds["R.y"]) < 1e-9]  # in the mirror plane (off it: the mirror pairs)
+    for kind, along_y in (("pitchfork", True), ("fold", False)):
+        rows = folds[folds.kind == kind]
+        assert len(rows) > 0
+        for _, row in rows.iloc[:: max(1, len(rows) // 8)].iterrows():
+            ref = _statics(row.x, row.y)
+            X0 = row[["R.x", "R.y", "R.z"]].to_numpy(float)[None]
+            _, _, H, A = tp.newton(ref, X0, None, steps=4)
+            null = np.linalg.svd(A[0])[2][len(ref.bars) :].T
+            ev, vec = np.linalg.eigh(null.T @ H[0] @ null)
+            soft = null @ vec[:, np.argmin(np.abs(ev))]
+            assert (abs(soft[1]) > 0.99) == along_y, (kind, row.x, row.y, soft)

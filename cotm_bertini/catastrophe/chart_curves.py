@@ -47,6 +47,9 @@ ON_CURVE = 3  # a seed within this many spacings (plane) and HMAX steps (pose) o
 CUSP_TOL = 1e-6  # |v . H_e v| / max(1, |H|) below this confirms a cusp (normalised units)
 CUSP_HALVINGS = 32  # bisections refining a cusp: its bracket (two steps) to 1e-10 of it
 NUDGE = 1e-7  # a switch's sides: this far (normalised length) into each
+PITCHFORK = 1e-4  # a fold point whose parameters' pull along the null direction is below this
+# (relative to their pull, _pull) is a pitchfork: the branch passes. Measured: 1e-17 on the
+# spatial Zeeman machine's, 3e-8 to 3e-6 on prism_slack's; 0.33 and up at the X-module's folds
 
 
 @dataclass(frozen=True, eq=False)
@@ -348,7 +351,8 @@ def chart_fold_curves(plane: ChartPlane, seeds, xrange: tuple[float, float],
                     "seconds": c.seconds} for i, c in enumerate(curves)],
         "trace_seconds": traced - started, "classify_seconds": time.perf_counter() - traced,
         "seconds": time.perf_counter() - started, **about,
-        "counts": {k: int((table["kind"] == k).sum()) for k in ("fold", "cusp", "cable_switch")},
+        "counts": {k: int((table["kind"] == k).sum())
+                   for k in ("fold", "cusp", "cable_switch", "pitchfork")},
     }  # fmt: skip
     return table, record
 
@@ -364,8 +368,9 @@ def _rows(plane: ChartPlane, curves: list[_Curve], win: Window) -> tuple[pd.Data
         arc /= win.diagonal
         kind = curve.seed.kind
         for z, a in zip(pts, arc, strict=True):
+            here = "pitchfork" if kind == "fold" and _pull(plane, z) < PITCHFORK else kind
             rows.append({**_point(plane, z, curve.seed, about), "curve_id": cid, "arc": a,
-                         "kind": kind})  # fmt: skip
+                         "kind": here})  # fmt: skip
         offset = 0
         for seg in curve.segments if kind == "fold" else []:
             for k, z in _cusps(curve.eqs, seg, win, CUSP_HALVINGS):
@@ -429,6 +434,18 @@ def _fold_stability(plane: ChartPlane, z: np.ndarray) -> tuple[bool, float]:
     _, Hs = plane.derivatives(np.stack([z[:n] + FD_ANGLE * v, z[:n] - FD_ANGLE * v]), z[n:])
     cubic = float(abs(v @ (Hs[0] - Hs[1]) @ v) / (2 * FD_ANGLE) / max(1.0, np.abs(H).max()))
     return bool((np.delete(eig, k) < 0).sum() == 0), cubic
+
+
+def _pull(plane: ChartPlane, z: np.ndarray) -> float:
+    """|v . dgrad/d(x, y)| / |dgrad/d(x, y)| at a point of the fold system (v the unit null
+    direction of H): 0 where the parameters cannot move the equilibria along v, so the branch
+    passes instead of turning (a pitchfork: by a symmetry, e.g. the mirror of a flat pose)."""
+    n = plane.n
+    _, H = plane.derivatives(z[:n], z[n:])
+    eig, vec = np.linalg.eigh(H[0])
+    v = vec[:, int(np.argmin(np.abs(eig)))]
+    gp = plane.grad_p(z[:n], z[n:])[0]
+    return float(np.abs(v @ gp).max() / max(np.abs(gp).max(), 1e-300))
 
 
 def _switch_stability(plane: ChartPlane, z: np.ndarray, cable: str) -> tuple:

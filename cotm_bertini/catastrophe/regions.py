@@ -30,11 +30,11 @@ def count_changes(regions: pd.DataFrame, x: str, y: str, column: str = "stable")
 
 
 def explaining(folds: pd.DataFrame) -> np.ndarray:
-    """The fold rows that can change the stable count: fold or cusp points flagged
+    """The fold rows that can change the stable count: fold, cusp or pitchfork points flagged
     `changes_stable_count`, and every cable switch."""
     kind = folds["kind"].to_numpy()
     changes = folds["changes_stable_count"].to_numpy(bool)
-    return (np.isin(kind, ("fold", "cusp")) & changes) | (kind == "cable_switch")
+    return (np.isin(kind, ("fold", "cusp", "pitchfork")) & changes) | (kind == "cable_switch")
 
 
 def _window_units(folds: pd.DataFrame, x: str, y: str, window: tuple) -> np.ndarray:

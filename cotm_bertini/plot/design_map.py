@@ -26,7 +26,7 @@ def map_figure(
     """Stable counts as coloured cells (gid `regions`), the fold curves and cusps (gid `cusps`)
     on top: for the paper, fold points (gids `fold-relaxed`, `fold-tensioned`) and its cases
     (gid `cases`); for a framework (cb.Framework), polylines (gids `fold-changes`,
-    `fold-no-change`, `cable-switch`)."""
+    `fold-no-change`, `cable-switch`, `pitchfork`)."""
     fig = Figure(figsize=(8.4, 7.2), layout="constrained")
     ax = fig.subplots()
     xname, yname = axes
@@ -65,15 +65,18 @@ def map_figure(
 
 def fold_subsets(params, folds: pd.DataFrame) -> list[tuple[str, pd.DataFrame, str, str]]:
     """(legend label, rows, colour, dash) of each kind of fold row: the paper's two families,
-    or a framework's folds that change the stable count, those that do not, cable switches."""
+    or a framework's folds that change the stable count, those that do not, cable switches,
+    pitchforks."""
     if isinstance(params, Params):
         families = (("relaxed", "#d95f02"), ("tensioned", "#e7298a"))
         return [(f"fold ({family} equilibria)",
                  folds[(folds.family == family) & (folds.kind == "fold")], colour, "solid")
                 for family, colour in families]  # fmt: skip
     switch = (folds.kind == "cable_switch").to_numpy()
-    changes = folds.changes_stable_count.to_numpy(bool) & ~switch
-    subsets = {"changes": changes, "no_change": ~changes & ~switch, "switch": switch}
+    pitch = (folds.kind == "pitchfork").to_numpy()
+    changes = folds.changes_stable_count.to_numpy(bool) & ~switch & ~pitch
+    subsets = {"changes": changes, "no_change": ~changes & ~switch & ~pitch, "switch": switch,
+               "pitchfork": pitch}  # fmt: skip
     return [(label, folds[subsets[which]], style["color"], _DASH[style["ls"]])
             for which, _, style, label in _STYLES]  # fmt: skip
 
@@ -106,6 +109,8 @@ _STYLES = (
      "fold of no consequence (stable count unchanged)"),
     ("switch", "cable-switch", {"color": "#1b9e77", "lw": 1.4, "ls": "-."},
      "cable switch (taut / slack)"),
+    ("pitchfork", "pitchfork", {"color": "#e7298a", "lw": 1.6, "ls": "--"},
+     "pitchfork (a symmetric state meets the mirror pair it splits into)"),
 )  # fmt: skip
 
 

@@ -38,6 +38,20 @@ def links(fw: Framework, active: tuple[str, ...], slots: dict | None = None) -> 
     )
 
 
+def taut_groups(cables: tuple[str, ...], links: tuple[Link, ...], d: dict[str, np.ndarray],
+                count: int) -> list[tuple[tuple[str, ...], np.ndarray]]:  # fmt: skip
+    """`count` points grouped by the cables taut at them (a cable with a free length: its
+    length `d` at least L0; one without: always): (the taut cables' names, the rows) each."""
+    taut = np.ones((count, len(cables)), dtype=bool)
+    for j, c in enumerate(cables):
+        x = next((y for y in links if y.name == c), None)
+        if x is not None and x.L0 is not None:
+            taut[:, j] = d[c] >= x.L0
+    return [(tuple(c for c, on in zip(cables, key, strict=True) if on),
+             np.flatnonzero((taut == np.array(key)).all(axis=1)))
+            for key in {tuple(row) for row in taut}]  # fmt: skip
+
+
 def force_density(x: Link, dd: Interval) -> tuple[Interval, np.ndarray]:
     """w over each box from the squared length `dd`, and a cable's state there (TAUT, SLACK
     or EITHER: then w is enclosed by the hull of 0 and k (1 - L0/d))."""

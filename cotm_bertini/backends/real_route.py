@@ -43,6 +43,7 @@ from .links import (
     found_endpoints,
     interval_sum,
     links,
+    taut_groups,
 )
 from .spheres import SphereFramework
 
@@ -251,15 +252,8 @@ class TorusFramework:
     def endpoints(self, roots: np.ndarray) -> dict[tuple[str, ...], Endpoints]:
         """The critical points (R, n angles) as endpoints of their taut sets' systems."""
         d = self._lengths(roots)
-        taut = np.ones((len(roots), len(self.cables)), dtype=bool)
-        for j, c in enumerate(self.cables):
-            x = next((y for y in self.links if y.name == c), None)
-            if x is not None and x.L0 is not None:
-                taut[:, j] = d[c] >= x.L0
         out = {}
-        for key in {tuple(row) for row in taut}:
-            rows = np.flatnonzero((taut == np.array(key)).all(axis=1))
-            names = tuple(c for c, on in zip(self.cables, key, strict=True) if on)
+        for names, rows in taut_groups(self.cables, self.links, d, len(roots)):
             out[names] = self._endpoints(framework_system(self.fw, names), roots[rows], d, rows)
         return out
 

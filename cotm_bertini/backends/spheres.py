@@ -36,7 +36,16 @@ from ..model.framework.units import normalized_slots
 from ..model.intervals import Interval, stack
 from .boxes import OFFSET
 from .endpoints import Endpoints
-from .links import SLACK, TAUT, columns, force_density, found_endpoints, interval_sum, links
+from .links import (
+    SLACK,
+    TAUT,
+    columns,
+    force_density,
+    found_endpoints,
+    interval_sum,
+    links,
+    taut_groups,
+)
 
 SHIFT = 8.0  # chart B's first angle is stored as a + SHIFT
 BAND = 0.6107  # chart A covers a in [BAND + TILT, pi - BAND + TILT]
@@ -331,15 +340,8 @@ class SphereFramework:
         sets' systems (node coordinates, each link's d and w, each bar's multiplier)."""
         roots = self.fresh(roots, np.zeros((0, self.n)))
         grad, X, _, _, d = self._numeric(roots)
-        taut = np.ones((len(roots), len(self.cables)), dtype=bool)
-        for j, c in enumerate(self.cables):
-            x = next((y for y in self.links if y.name == c), None)
-            if x is not None and x.L0 is not None:
-                taut[:, j] = d[c] >= x.L0
         out = {}
-        for key in {tuple(row) for row in taut}:
-            rows = np.flatnonzero((taut == np.array(key)).all(axis=1))
-            names = tuple(c for c, on in zip(self.cables, key, strict=True) if on)
+        for names, rows in taut_groups(self.cables, self.links, d, len(roots)):
             fs = framework_system(self.fw, names)
             out[names] = self._endpoints(fs, X[rows], {k: v[rows] for k, v in d.items()},
                                          grad[rows])  # fmt: skip

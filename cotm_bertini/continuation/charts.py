@@ -80,16 +80,7 @@ class ChartPlane:
 
     def grad_p(self, theta: np.ndarray, p) -> np.ndarray:
         """d grad V / d(x, y) at chart points theta (R, n): (R, n, 2), central differences."""
-        theta = np.atleast_2d(theta)
-        out = np.empty((len(theta), self.n, 2))
-        for k in range(2):
-            h = FD * (1.0 + abs(p[k]))
-            up, down = list(p), list(p)
-            up[k], down[k] = p[k] + h, p[k] - h
-            out[:, :, k] = (self.derivatives(theta, up)[0] - self.derivatives(theta, down)[0]) / (
-                2 * h
-            )
-        return out
+        return np.stack([self.grad_along(theta, p, e) for e in np.eye(2)], axis=-1)
 
     def index(self, theta: np.ndarray, p) -> tuple[np.ndarray, np.ndarray]:
         """Each point's Morse index (negative eigenvalues of the chart Hessian) and its

@@ -37,8 +37,8 @@ from ..model.intervals import Interval, stack
 from .boxes import OFFSET
 from .endpoints import Endpoints
 from .links import (
+    EITHER,
     SLACK,
-    TAUT,
     columns,
     force_density,
     found_endpoints,
@@ -120,7 +120,7 @@ class SphereFramework:
         # The generated code's local coordinates are the nodes' coordinates, in this order.
         if self.coords != list(range(self.full.local_size)):
             raise ValueError(f"{fw.name}: node coordinates are not the local coordinates")
-        self.k_slots = {c: list(self.slots).index(f"k_{c}") for c in self.cables}
+        self.stencil = self._stencil()
 
     def renumber(self, slots: dict | None = None) -> None:
         """The numbers taken from normalised `slots` (default: the framework's): the
@@ -232,19 +232,53 @@ class SphereFramework:
         count = box.lo.shape[0]
         positions, dirs = self.kinematics(box)
         g, _, _ = self.node_gradient(positions, count)
-        P = list(self.P)
-        for c, j in self.k_slots.items():
-            s = states.get(c, np.full(count, TAUT))
-            P[j] = Interval(np.where(s == TAUT, P[j], 0.0), np.where(s == SLACK, 0.0, P[j]))
-        h = ball_module(self.full).hessian(self.pose(positions, count), P)
-        m = len(positions)
-        flat = stack([Interval(np.zeros(count)) + v for v in h], axis=1)
-        H = Interval(flat.lo.reshape(count, m, m), flat.hi.reshape(count, m, m))
+        H = self.node_hessian(positions, count)
         J = stack([stack(row, axis=1) for row in self.jacobian(dirs, count)], axis=1)
         JT = Interval(np.swapaxes(J.lo, 1, 2), np.swapaxes(J.hi, 1, 2))
         HJ = (H[:, :, :, None] * J[:, None, :, :]).isum(axis=2)
         out = (JT[:, :, :, None] * HJ[:, None, :, :]).isum(axis=2)
         return self._curvature(out, g, dirs, count)
+
+    def _stencil(self) -> np.ndarray:
+        """(links, 3, node coordinates): dr/dX of each link's r = a - b, constant (its ends are
+        nodes and ground points); read from the generated code at two poses, checked equal."""
+        m, per = len(self.coords), 3 + 3 * len(self.coords)
+        rng, P = np.random.default_rng(0), np.tile(np.asarray(self.P), (2, 1))
+        X = np.zeros((2, len(self.full.ps.variables)))
+        X[:, self.coords] = rng.normal(size=(2, m))
+        first = columns(self.full.numeric.first_order(X, P), 2)
+        dr = np.stack([first[:, i * per + 3 : (i + 1) * per] for i in range(len(self.links))], 1)
+        if not np.array_equal(dr[0], dr[1]):
+            raise ValueError(f"{self.fw.name}: a link's ends move other than as nodes")
+        return dr[0].reshape(len(self.links), 3, m)
+
+    def node_hessian(self, positions: list, count: int) -> Interval:
+        """The Hessian of V in node coordinates over boxes (B, m, m), summed link by link from
+        each link's r and its state there: a slack cable adds nothing, one that may be either
+        the hull of nothing and its taut term. (The generated Hessian has every cable taut,
+        with stiffnesses that no parameter sets folded in as numbers: no slot can switch a
+        cable off.) Loads are linear in X and bars are the charts: neither adds a term."""
+        first = ball_module(self.full).first_order(self.pose(positions, count), self.P)
+        m, per = len(positions), 3 + 3 * len(positions)
+        acc: dict[tuple[int, int], Interval] = {}
+        for i, x in enumerate(self.links):
+            r = [Interval(np.zeros(count)) + first[i * per + c] for c in range(3)]
+            block = _link_block(x, r)
+            for c in range(3):
+                for e in range(3):
+                    if block[c][e] is None:
+                        continue
+                    for j in np.flatnonzero(self.stencil[i, c]):
+                        for q in np.flatnonzero(self.stencil[i, e]):
+                            if q < j:
+                                continue
+                            t = block[c][e] * float(self.stencil[i, c, j] * self.stencil[i, e, q])
+                            acc[j, q] = t if (j, q) not in acc else acc[j, q] + t
+        lo, hi = np.zeros((count, m, m)), np.zeros((count, m, m))
+        for (j, q), t in acc.items():
+            lo[:, j, q], hi[:, j, q] = t.lo, t.hi
+            lo[:, q, j], hi[:, q, j] = t.lo, t.hi
+        return Interval(lo, hi)
 
     def _curvature(self, out, g: list, dirs: list, count: int):
         """Add sum_i g_i d2X_i/d(angles)^2: each node's own 2 x 2 block, length times the
@@ -263,13 +297,9 @@ class SphereFramework:
 
     def derivatives(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """grad V and its Hessian at points (R, n chart angles) in double precision (each
-        point's Hessian that of its taut set: slack cables' stiffness 0)."""
+        point's Hessian that of its taut set: a slack cable adds nothing)."""
         count = len(x)
-        g, X, P, dirs, _ = self._numeric(x)
-        m = X.shape[1]
-        full = np.zeros((count, len(self.full.ps.variables)))
-        full[:, self.coords] = X
-        H = columns(self.full.numeric.hessian(full, P), count).reshape(count, m, m)
+        g, H, _, dirs, _ = self._numeric(x)
         J = np.stack([np.stack(row, axis=1) for row in self.jacobian(dirs, count)], axis=1)
         hess = np.einsum("nia,nij,njb->nab", J, H, J)
         for i, v in enumerate(self.nodes):
@@ -279,27 +309,32 @@ class SphereFramework:
         return np.einsum("nia,ni->na", J, g), hess
 
     def _numeric(self, x: np.ndarray) -> tuple:
-        """At points (R, n chart angles): grad V in node coordinates, the node coordinates,
-        the parameters with each slack cable's stiffness 0 (its taut set's Hessian), the
-        directions with their derivatives, and each spring's and cable's length."""
+        """At points (R, n chart angles): grad V and its Hessian in node coordinates (each
+        point's taut set), the node coordinates, the directions with their derivatives, and
+        each spring's and cable's length."""
         count = len(x)
         positions, dirs = self.kinematics(x)
         X = np.zeros((count, len(self.full.ps.variables)))
         X[:, self.coords] = np.stack(positions, axis=1)
-        P = np.tile(np.asarray(self.P), (count, 1))
-        first = self.full.numeric.first_order(X, P)
+        first = self.full.numeric.first_order(X, np.tile(np.asarray(self.P), (count, 1)))
         m, per = len(positions), 3 + 3 * len(positions)
         g, lengths = columns(first[len(self.links) * per :], count), {}
+        H = np.zeros((count, m, m))
         for i, link in enumerate(self.links):
-            block = columns(first[i * per : (i + 1) * per], count)
-            r, dr = block[:, :3], block[:, 3:].reshape(count, 3, m)
+            r = columns(first[i * per : i * per + 3], count)
             d = lengths[link.name] = np.sqrt((r * r).sum(axis=1))
-            w = np.full(count, link.k) if link.L0 is None else link.k * (1 - link.L0 / d)
-            if link.cable and link.L0 is not None:
-                P[:, self.k_slots[link.name]] *= d > link.L0
-                w = np.where(d > link.L0, w, 0.0)
-            g += w[:, None] * np.einsum("nc,ncj->nj", r, dr)
-        return g, X[:, self.coords], P, dirs, lengths
+            w, M = np.full(count, link.k), np.zeros((count, 3, 3))
+            if link.L0 is not None:
+                w = link.k * (1 - link.L0 / d)
+                M = np.einsum("n,nc,ne->nce", link.k * link.L0 / d**3, r, r)
+                if link.cable:
+                    taut = d > link.L0
+                    w, M = np.where(taut, w, 0.0), M * taut[:, None, None]
+            M = M + w[:, None, None] * np.eye(3)  # the Hessian of the link's energy in r
+            D = self.stencil[i]
+            g += np.einsum("n,nc,cj->nj", w, r, D)
+            H += np.einsum("cj,nce,eq->njq", D, M, D)
+        return g, H, X[:, self.coords], dirs, lengths
 
     def cable_lengths(self, x: np.ndarray) -> dict[str, np.ndarray]:
         """Each link's length at points (R, n chart angles), normalised units as `links`' L0."""
@@ -339,7 +374,7 @@ class SphereFramework:
         """The critical points (chart angles), each pose once, as endpoints of their taut
         sets' systems (node coordinates, each link's d and w, each bar's multiplier)."""
         roots = self.fresh(roots, np.zeros((0, self.n)))
-        grad, X, _, _, d = self._numeric(roots)
+        grad, _, X, _, d = self._numeric(roots)
         out = {}
         for names, rows in taut_groups(self.cables, self.links, d, len(roots)):
             fs = framework_system(self.fw, names)
@@ -387,6 +422,29 @@ class SphereFramework:
             else:
                 raise ValueError(f"the real route has no value for unknown {v}")
         return found_endpoints(fs.ps.variables, values, np.arange(len(X)))
+
+
+def _link_block(x, r: list) -> list[list]:
+    """The Hessian of a link's energy in its r = a - b over boxes (3 x 3 Intervals, None for
+    a term that is 0): k I without a free length; else w I + k L0 r r^T / d^3, w the force
+    density; a cable's terms hulled with 0 where it may be slack, 0 where it is."""
+    if x.L0 is None:
+        return [[Interval(np.full(r[0].lo.shape, x.k)) if c == e else None for e in range(3)]
+                for c in range(3)]  # fmt: skip
+    dd = interval_sum(c.square() for c in r)
+    w, state = force_density(x, dd)
+    t = (x.k * x.L0) / (dd.sqrt() * dd)
+    out = [[(r[c].square() if c == e else r[c] * r[e]) * t for e in range(3)] for c in range(3)]
+    if x.cable:
+        slack, either = state == SLACK, state == EITHER
+        for row in out:
+            for e, v in enumerate(row):
+                lo = np.where(slack, 0.0, np.where(either, np.minimum(v.lo, 0.0), v.lo))
+                hi = np.where(slack, 0.0, np.where(either, np.maximum(v.hi, 0.0), v.hi))
+                row[e] = Interval(lo, hi)
+    for c in range(3):
+        out[c][c] = out[c][c] + w
+    return out
 
 
 def _dot(u: list, v: list):

@@ -27,6 +27,7 @@ from .settings import Settings, Tolerances
 
 STATUS_OK = "ok"
 STATUS_INCOMPLETE = "incomplete"
+STATUS_CONTRADICTION = "contradiction"  # a proof that contradicts an independent check: a bug
 
 
 @dataclass
@@ -54,7 +55,7 @@ class PointSolution:
     endpoints: Endpoints
     counts: dict
     morse: dict
-    status: str  # "ok", or "incomplete" when a completeness check failed
+    status: str  # "ok"; "incomplete" when a completeness check failed; "contradiction"
     warnings: tuple[str, ...]
     engine: dict  # flavour, path, version
     system: dict  # variables, functions, degrees, total degree
@@ -102,9 +103,10 @@ def path_counts(
     }
 
 
-def _checks(morse: dict, counts: dict, generic: list[str]) -> tuple[str, tuple[str, ...]]:
+def _checks(morse: dict, counts: dict, generic: list[str], proved: bool = False) -> tuple:
     """The status and the warnings of a solve: complete, or why equilibria may be missing
-    (`generic`: why its generic set is incomplete, if it is)."""
+    (`generic`: why its generic set is incomplete, if it is), or a contradiction (`proved`: a
+    real search proved the rows complete, and the Morse count says otherwise)."""
     warnings = list(generic)
     if not morse["ok"]:
         total = morse["euler_characteristic"]
@@ -113,7 +115,11 @@ def _checks(morse: dict, counts: dict, generic: list[str]) -> tuple[str, tuple[s
         )
         parts += [f"{morse['degenerate']} degenerate"] * bool(morse["degenerate"])
         parts += ["no minimum, though V has one on the compact torus"] * (not morse["min"])
-        warnings.append("; ".join(parts) + ": equilibria may be missing")
+        warnings.append(
+            f"contradiction: the real search proved the rows complete, yet {'; '.join(parts)}: "
+            "a bug (please report it with run.json)" if proved
+            else "; ".join(parts) + ": equilibria may be missing"
+        )  # fmt: skip
     if counts.get("lost_paths"):
         warnings.append(f"{counts['lost_paths']} paths lost: solutions may be missing")
     if counts.get("crossings_unresolved"):
@@ -121,6 +127,8 @@ def _checks(morse: dict, counts: dict, generic: list[str]) -> tuple[str, tuple[s
             f"{counts['crossings_unresolved']} paths crossed another path and the solver could "
             "not part them: the affected solutions may be wrong"
         )
+    if any(w.startswith("contradiction:") for w in warnings):
+        return STATUS_CONTRADICTION, tuple(dict.fromkeys(warnings))
     return (STATUS_INCOMPLETE if warnings else STATUS_OK), tuple(warnings)
 
 
@@ -162,9 +170,10 @@ def solve_point(
     if "real_search" in details:  # no path: the endpoints are the search's critical points
         counts.update(finite_endpoints=0, infinite_or_failed_paths=0,
                       boxes=details["real_search"]["boxes"])  # fmt: skip
+    proved = "real_search" in details and not details["real_search"]["warnings"]
     status, warnings = _checks(
         morse, counts, details.get("homotopy", {}).get("generic_warnings", [])
-        + details.get("framework_warnings", []),
+        + details.get("framework_warnings", []), proved,
     )  # fmt: skip
     shape = {
         "variables": list(system.variables),
@@ -469,13 +478,23 @@ def _solve_real(
     if descents["starts"]:
         search_info["descents"] = {k: v for k, v in descents.items() if k != "points"}
     warnings = tuple(search_info["warnings"] + checks["warnings"])
+    status = STATUS_INCOMPLETE if warnings else STATUS_OK
+    failure = checks["morse"].get("failure")
+    if failure and not search_info["warnings"]:
+        # The search proved its rows are every critical point; the Morse count, which shares
+        # none of its code, says they are not: one of the two is wrong, and no later check
+        # can tell which. That is a bug to report, never a set that "may" be incomplete.
+        status = STATUS_CONTRADICTION
+        warnings = (f"contradiction: the real search proved its {len(found.roots)} critical "
+                    f"points are all there are, yet {failure}: a bug (please report it with "
+                    "run.json)",
+                    *(w for w in warnings if not w.startswith(failure)))  # fmt: skip
     counts = {**framework_counts(table, report, continua), "boxes": found.boxes}
     engine = {"flavour": "real", "path": "branch and bound (backends.boxes)", "version": ""}
     shape = {"taut_sets": list(report), "units": {"length": unit[0], "stiffness": unit[1]}}
     return PointSolution(
         fw, settings, table, None, counts, checks["morse"],
-        STATUS_INCOMPLETE if warnings else STATUS_OK, warnings, engine, shape,
-        {"taut_sets": report, "real_search": search_info}, "", t.stages, None,
+        status, warnings, engine, shape, {"taut_sets": report, "real_search": search_info}, "", t.stages, None,
         tuple(continuum_record(c, n) for n, c in enumerate(continua, start=1)),
     )  # fmt: skip
 

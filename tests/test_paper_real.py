@@ -139,8 +139,9 @@ def test_a_lost_root_is_caught_by_the_papers_morse_count(monkeypatch):
     torus (zero-length cusps in closed form, not the search's) sees the hole."""
     dropped = lose_first_root(monkeypatch)
     res = _real(cb.Params.case("case1"))
-    assert dropped and len(res.physical) == 3 and res.status == "incomplete"
-    assert any("#min - #saddle + #max" in w for w in res.warnings)
+    assert dropped and len(res.physical) == 3 and res.status == "contradiction"
+    assert any(w.startswith("contradiction:") and "#min - #saddle + #max" in w
+               for w in res.warnings)  # fmt: skip
 
 
 def test_the_command_line_solves_the_paper_on_the_real_route(tmp_path):

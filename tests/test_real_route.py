@@ -15,6 +15,7 @@ import pytest
 from conftest import ROOT, lose_first_root
 
 import cotm_bertini as cb
+from cotm_bertini.cli.main import main as cli_main
 from cotm_bertini.model.intervals import Interval
 
 XMODULE = ROOT / "examples" / "xmodule.toml"
@@ -304,14 +305,21 @@ def test_a_search_stopped_early_is_incomplete_never_ok(tmp_path):
     assert out.returncode == 5, out.stdout + out.stderr
 
 
-def test_a_lost_root_is_caught_by_the_morse_count(monkeypatch):
+def test_a_lost_root_is_caught_by_the_morse_count(monkeypatch, tmp_path):
     """Sabotage: the search drops the first root it proves; the Morse count on the torus sees
-    the hole and the status says equilibria may be missing."""
+    the hole. The search called itself complete, so that is a contradiction (a bug), not a set
+    that may be incomplete: status contradiction, and the command line exits 4."""
     dropped = lose_first_root(monkeypatch)
     res = cb.solve(cb.Framework.from_toml(XMODULE), route="real", cache=False)
     assert dropped and len(res.physical) == 11
-    assert res.status == "incomplete"
-    assert any("Morse" in w for w in res.warnings)
+    assert res.status == "contradiction"
+    assert res.warnings[0].startswith("contradiction: the real search proved its 11 critical")
+    assert "Morse count" in res.warnings[0]
+    assert not any("may be missing" in w for w in res.warnings)
+    dropped.clear()  # the next search drops its first root too
+    code = cli_main(["solve", "--framework", str(XMODULE), "--route", "real", "--no-cache",
+                     "--no-plots", "--quiet", "--out", str(tmp_path)])  # fmt: skip
+    assert code == 4 and dropped
 
 
 def test_route_real_for_the_papers_mechanism_refuses_what_it_cannot_honour(tmp_path):

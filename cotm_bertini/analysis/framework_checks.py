@@ -134,6 +134,7 @@ def completeness(
         none = not (morse["min"] or morse["continua_minima"])
         parts += [f"no minimum, though V has one on the compact {space}"] * none
         warnings.append("; ".join(parts) + ": equilibria may be missing")
+        morse["failure"] = "; ".join(parts)
     return {"morse": morse, "warnings": warnings}
 
 

@@ -108,7 +108,8 @@ class Solutions:
 
     @property
     def status(self) -> str:
-        """'ok', or 'incomplete' when a completeness check failed (see `warnings`)."""
+        """'ok'; 'incomplete' when a completeness check failed; 'contradiction' when a proof
+        and an independent check disagree, a bug (see `warnings`)."""
         return self.record["status"]
 
     @property

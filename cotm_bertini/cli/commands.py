@@ -78,6 +78,8 @@ def solve(args: argparse.Namespace) -> int:
             return EXIT_CERTIFICATE
         if cert.status not in ("proved", "rows proved"):  # rows proved: no completeness claim
             return EXIT_INCOMPLETE
+    if res.status == "contradiction":
+        return EXIT_CERTIFICATE
     return EXIT_OK if res.status == "ok" else EXIT_INCOMPLETE
 
 

@@ -494,7 +494,8 @@ def _solve_real(
     shape = {"taut_sets": list(report), "units": {"length": unit[0], "stiffness": unit[1]}}
     return PointSolution(
         fw, settings, table, None, counts, checks["morse"],
-        status, warnings, engine, shape, {"taut_sets": report, "real_search": search_info}, "", t.stages, None,
+        status, warnings, engine, shape, {"taut_sets": report, "real_search": search_info}, "",
+        t.stages, None,
         tuple(continuum_record(c, n) for n, c in enumerate(continua, start=1)),
     )  # fmt: skip
 

@@ -548,8 +548,9 @@ def real_table(fw, groups: dict, tolerances: Tolerances) -> dict:
 
 def along_continua(land, found, continua: list) -> int:
     """How many of the search's undecided boxes lie along a traced continuum: within the
-    largest step between its traced points (in the body angles) of one of them."""
-    if not continua or not len(found.undecided):
+    largest step between its traced points (in the body angles) of one of them. (Chart
+    angles of spheres are not body angles: none is counted there.)"""
+    if not continua or not len(found.undecided) or not land.bodies:
         return 0
     n = land.n
     mid = 0.5 * (found.undecided[:, :n] + found.undecided[:, n:])
@@ -589,6 +590,15 @@ def real_search_info(found, length_unit: float, along: int = 0, morse_bott: bool
         )  # fmt: skip
     if found.newton_failed:
         warnings.append(f"{found.newton_failed} proved critical points not reached by Newton")
+    free = _free_regions(found)
+    if free:
+        warnings.append(
+            "V is flat over regions of poses where a node has every cable slack and no load: "
+            + "; ".join(f"angles {r['free_angles']} free, {r['pieces']} boxes, the other "
+                        f"angles at one equilibrium" for r in free)
+            + ": a continuum of equilibria there, not listed as rows"
+            + (f" ({found.edge} boxes at its edges left undecided)" if found.edge else "")
+        )  # fmt: skip
     return {
         "boxes": found.boxes,
         "seconds": round(found.seconds, 4),
@@ -604,9 +614,29 @@ def real_search_info(found, length_unit: float, along: int = 0, morse_bott: bool
         "undecided_along_continua": along,
         "undecided_share": found.undecided_share,
         "undecided_boxes_deg": np.degrees(found.undecided[:20]).round(6).tolist(),
+        "free_regions": free,
+        "undecided_at_free_edges": found.edge,
         "warnings": warnings,
         "notes": notes,
     }
+
+
+def _free_regions(found) -> list[dict]:
+    """The search's free pieces grouped by which angles are free and where the other angles'
+    equilibrium is (to 1e-8 rad): one region each, with its pieces and that point."""
+    out: list[dict] = []
+    if not len(found.free_boxes):
+        return out
+    for mask, x in zip(found.free_masks, found.free_points, strict=True):
+        angles = [int(i) for i in np.flatnonzero(mask)]
+        same = next((r for r in out if r["free_angles"] == angles
+                     and np.abs(np.asarray(r["point_rad"]) - x)[~mask].max(initial=0) < 1e-8),
+                    None)  # fmt: skip
+        if same is None:
+            out.append({"free_angles": angles, "pieces": 1, "point_rad": x.round(12).tolist()})
+        else:
+            same["pieces"] += 1
+    return out
 
 
 def taut_sets(fw) -> list[tuple[str, ...]]:

@@ -15,13 +15,15 @@ import numpy as np
 
 @dataclass(frozen=True)
 class Spatial:
-    """A framework: `anchors` (name -> xyz), `free` node names, bars (a, b, length) and cables
-    (name, a, b, k, L0); a and b name an anchor or a free node."""
+    """A framework: `anchors` (name -> xyz), `free` node names, bars (a, b, length), cables
+    (name, a, b, k, L0) and loads (node, force: V = -force . x); a and b name an anchor or a
+    free node."""
 
     anchors: dict
     free: tuple
     bars: tuple
     cables: tuple
+    loads: tuple = ()
 
     def point(self, X: np.ndarray, name: str) -> np.ndarray:
         """The point's coordinates for every pose of X (s x 3m): (s, 3)."""
@@ -38,7 +40,8 @@ class Spatial:
     def energy(self, X: np.ndarray) -> np.ndarray:
         """V of every pose: the taut cables' stretch energies."""
         stretch = np.maximum(self.lengths(X) - np.array([c[4] for c in self.cables]), 0.0)
-        return 0.5 * stretch**2 @ np.array([c[3] for c in self.cables], float)
+        work = sum((self.point(X, n) @ np.asarray(f, float) for n, f in self.loads), 0.0)
+        return 0.5 * stretch**2 @ np.array([c[3] for c in self.cables], float) - work
 
 
 def _slot(fw: Spatial, name: str) -> int | None:
@@ -75,6 +78,9 @@ def _lagrange(fw: Spatial, taut: tuple | None, X: np.ndarray, lam: np.ndarray):
         elif name in taut:
             _add_link(G, H, fw, X, a, b, lambda d, k=k, L0=L0: k * (1 - L0 / d),
                       lambda d, k=k, L0=L0: k * L0 / d**3)  # fmt: skip
+    for node, f in fw.loads:
+        p = fw.free.index(node)
+        G[:, 3 * p : 3 * p + 3] -= np.asarray(f, float)
     A, g = np.zeros((s, m, n)), np.zeros((s, m))
     for j, (a, b, length) in enumerate(fw.bars):
         Gb, Hb = np.zeros((s, n)), np.zeros((s, n, n))

@@ -45,6 +45,8 @@ NEAR_CONDITION = 1e10  # a critical point worth splitting below MIN_WIDTH for is
 ROOT_FLOOR = 1e-10  # radians: boxes are not split below this, whatever a spring's length
 MAX_CUTS = 2  # sides halved at a split (see _split)
 KRAWCZYK_BATCH = 1024  # boxes for the Krawczyk test wait until this many are pending
+FREE, EDGE = 2, 1  # landscape.free's codes: an angle V is flat along, or may be (see _step)
+EDGE_WIDTH = 0.05  # radians: a box at the edge of a free region this small is left undecided
 
 
 class BoxLandscape(Protocol):
@@ -64,6 +66,9 @@ class BoxLandscape(Protocol):
 
     # Optional: `domain(start) -> (lo, hi)`, the boxes that cover the configuration space
     # (charts of a sphere, say); without it the torus grid of `initial_boxes`.
+    # Optional: `free(states, B) -> (B, n) int`, FREE for the angles grad V cannot depend on
+    # over each box, its components along them 0 whatever the angles (a node with every element
+    # slack and no load), EDGE where that may be so: see _step.
 
 
 class BoxFamily(Protocol):
@@ -98,6 +103,15 @@ class BoxSearch:
     volume: float = 0.0  # of the domain searched (0: the torus, (2 pi)^n)
     cpu_seconds: float = 0.0  # in every process that searched (`seconds` is the wall time)
     shares: int = 1  # the shares of boxes searched apart (backends.box_shares), merged here
+    # Boxes where grad V is 0 along some angles whatever they are (a node whose every element
+    # is slack, with no load: V is flat along it), each with exactly one critical point of the
+    # other angles, the same for every value of the free ones: pieces of a region of
+    # equilibria. (F, 2n) boxes, (F, n) their points (free angles: the box's middle), (F, n)
+    # which angles are free.
+    free_boxes: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    free_points: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    free_masks: np.ndarray = field(default_factory=lambda: np.zeros((0, 0), dtype=bool))
+    edge: int = 0  # of the undecided boxes, those at the edge of a free region (EDGE_WIDTH)
 
     @property
     def undecided_share(self) -> float:
@@ -175,6 +189,8 @@ class _Member:
     shortest: float = math.inf
     failed: int = 0
     budget: str = ""
+    free: list = field(default_factory=list)  # (box, point, mask) rows of free pieces
+    edge: int = 0
 
     def stop(self, why: str) -> None:
         """Every box not yet decided listed as undecided (the next batch first), with why the
@@ -200,11 +216,13 @@ class _Member:
 
     def result(self, n: int, clocks: tuple, volume: float) -> BoxSearch:
         """The record (`clocks`: this search's wall and CPU seconds)."""
+        free = _rows(self.free, 4 * n)
         return BoxSearch(
             _rows(self.roots, n), _rows(self.root_boxes, 2 * n), self.failed,
             self.aside, self.bound, _rows(self.aside_boxes, 2 * n), _rows(self.undecided, 2 * n),
             self.boxes, clocks[0], self.shortest, self.budget, volume=volume,
-            cpu_seconds=clocks[1],
+            cpu_seconds=clocks[1], free_boxes=free[:, : 2 * n], free_points=free[:, 2 * n : 3 * n],
+            free_masks=free[:, 3 * n :] > 0.5, edge=self.edge,
         )  # fmt: skip
 
 
@@ -282,12 +300,15 @@ def merged(parts: list[BoxSearch], volume: float, seconds: float, apart: float =
         notes.append(f"{len(roots) - len(keep)} roots proved in two shares' boxes kept once")
     total = lambda name: sum(getattr(p, name) for p in parts)  # noqa: E731
     boxes = lambda name: _rows([getattr(p, name) for p in parts], 2 * n)  # noqa: E731
+    free = [p for p in parts if p.free_boxes.size]
     return BoxSearch(
         roots[keep], boxes("root_boxes")[keep], total("newton_failed"), total("set_aside"),
         max(p.set_aside_bound for p in parts), boxes("set_aside_boxes"), boxes("undecided"),
         total("boxes"), seconds, min(p.shortest_length for p in parts),
         f"{len(hits)} of {shares} shares {hits[0]}" if hits else "", notes, volume,
-        total("cpu_seconds"), shares,
+        total("cpu_seconds"), shares, _rows([p.free_boxes for p in free], 2 * n),
+        _rows([p.free_points for p in free], n),
+        _rows([p.free_masks for p in free], n).astype(bool), total("edge"),
     )  # fmt: skip
 
 
@@ -358,19 +379,24 @@ class _Outcome:
     parent: np.ndarray
     later_rows: np.ndarray
     later: tuple[np.ndarray, np.ndarray]  # boxes for the Krawczyk test, handed back
+    free_rows: np.ndarray
+    free: np.ndarray  # (f, 4n): lo, hi, the point, the free angles (1.0) of each free piece
+    edge_rows: np.ndarray  # of the boxes left, those at the edge of a free region
 
     def parts(self, ends: np.ndarray) -> list[_Part]:
         """Each member's share of the outcome (the members' rows end at `ends`)."""
         if len(ends) == 1:
             return [_Part(int(ends[0]), self.aside, self.cone, self.leaf_short, self.roots,
                           self.root_boxes, self.root_good, self.left, self.split,
-                          self.later)]  # fmt: skip
+                          self.later, self.free, len(self.edge_rows))]  # fmt: skip
         cut = lambda rows, *arrays: [np.split(a, np.searchsorted(rows, ends[:-1]))  # noqa: E731
                                      for a in arrays]  # fmt: skip
         aside, cone = cut(self.aside_rows, self.aside)[0], cut(self.cone_rows, self.cone)[0]
         (short,) = cut(self.leaf_rows, self.leaf_short)
         roots, boxes, good = cut(self.root_rows, self.roots, self.root_boxes, self.root_good)
         (left,) = cut(self.left_rows, self.left)
+        (free,) = cut(self.free_rows, self.free)
+        edge = np.diff(np.searchsorted(self.edge_rows, ends), prepend=0)
         later = zip(*cut(self.later_rows, *self.later), strict=True)
         member = np.searchsorted(ends, self.parent, side="right")
         order = np.argsort(member, kind="stable")  # each member's children in their order
@@ -378,7 +404,8 @@ class _Outcome:
         lo, hi = (np.split(a[order], at) for a in self.split)
         sizes = np.diff(ends, prepend=0)
         return [_Part(*v) for v in zip(sizes, aside, cone, short, roots, boxes, good, left,
-                                        zip(lo, hi, strict=True), later, strict=True)]  # fmt: skip
+                                        zip(lo, hi, strict=True), later, free, edge,
+                                        strict=True)]  # fmt: skip
 
 
 @dataclass
@@ -395,6 +422,8 @@ class _Part:
     left: np.ndarray
     split: tuple[np.ndarray, np.ndarray]
     later: tuple[np.ndarray, np.ndarray]
+    free: np.ndarray
+    edge: int
 
     def record(self, m: _Member, counted: bool) -> None:
         """Into the member's search: counts (the boxes unless `counted` when first taken),
@@ -413,6 +442,9 @@ class _Part:
             m.failed += int((~self.root_good).sum())
         if len(self.left):
             m.undecided.append(self.left)
+        if len(self.free):
+            m.free.append(self.free)
+        m.edge += int(self.edge)
         if len(self.split[0]):
             m.stack.append(self.split)
         if len(self.later[0]):
@@ -424,8 +456,14 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, testing) -
     box small enough for the Krawczyk test, where `testing` is False) handed back for it."""
     box = Interval(lo, hi)
     rows = np.arange(len(lo))
-    width = (hi - lo).max(axis=1)
     dd, grad, states = land.enclose(box)
+    # Along free angles grad V is 0 whatever they are: the box is searched in the others.
+    code = _free(land, states, lo.shape)
+    free = code == FREE
+    width = np.where(free, 0.0, hi - lo).max(axis=1)
+    # At the edge of a free region (a node's cables may all be slack) every box holds
+    # equilibria of the region, and halving cannot decide it: left undecided, counted apart.
+    edge = (code == EDGE).any(axis=1) & (width <= EDGE_WIDTH)
     aside, smooth = np.zeros(len(lo), dtype=bool), np.ones(len(lo), dtype=bool)
     floor = np.full(len(lo), float(min_width))
     springs = dd.lo.shape[1] > 0
@@ -437,6 +475,7 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, testing) -
     test = np.flatnonzero(~aside & smooth)
     n = lo.shape[1]
     found = (rows[:0], np.zeros((0, n)), np.zeros((0, 2 * n)), np.zeros(0, dtype=bool))
+    pieces = (rows[:0], np.zeros((0, 4 * n)))
     if len(test):
         zero = grad[test].contains_zero().all(axis=1)
         decided[test[~zero]] = True
@@ -445,15 +484,21 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, testing) -
         cand = cand[testing[cand]]
         if len(cand):
             verdict, k_lo, k_hi = krawczyk(_sub(land, cand), lo[cand], hi[cand],
-                                           _subset(states, cand))  # fmt: skip
+                                           _subset(states, cand), free[cand])  # fmt: skip
             decided[cand[verdict != 0]] = True
-            one = verdict == 1
+            flat = free[cand].any(axis=1)
+            one = (verdict == 1) & ~flat
             if one.any():
                 at = cand[one]
                 found = (at, *_roots(_sub(land, at), lo[at], hi[at], k_lo[one], k_hi[one]))
+            one = (verdict == 1) & flat
+            if one.any():
+                at = cand[one]
+                x = _free_points(_sub(land, at), lo[at], hi[at], k_lo[one], k_hi[one], free[at])
+                pieces = (at, np.hstack([lo[at], hi[at], x, free[at]]))
     leaf = ~aside & (decided | ~smooth) if springs else np.zeros(len(lo), dtype=bool)
     rest = ~aside & ~decided & ~later
-    small = rest & (width <= floor)
+    small = rest & ((width <= floor) | edge)
     if small.any():  # a root in or next to the box: split on (Krawczyk wants small boxes there)
         at = np.flatnonzero(small)
         near = _root_near(_sub(land, at), lo[at], hi[at])
@@ -469,15 +514,15 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, testing) -
     # aside at the smallest width: two halvings at once there save a batch step each.
     deep = rest & ~small & ~smooth & (width > 4 * min_width)
     plain = rest & ~small & ~deep
-    once = _split(lo[plain], hi[plain], rows[plain])
-    twice = _split(*_split(lo[deep], hi[deep], rows[deep]))
+    once = _split(lo[plain], hi[plain], rows[plain], free)
+    twice = _split(*_split(lo[deep], hi[deep], rows[deep], free), free)
     bound = lambda m: np.hstack([lo[m], hi[m], _spring_bound(dd.hi[m])[:, None]])  # noqa: E731
     low = np.sqrt(np.maximum(dd.lo[leaf].min(axis=1), 0.0)) if springs else np.zeros(0)
     return _Outcome(
         len(lo), rows[aside], bound(aside), rows[cone], bound(cone), rows[leaf], low, *found,
         rows[small], np.hstack([lo[small], hi[small]]), (np.vstack([once[0], twice[0]]),
         np.vstack([once[1], twice[1]])), np.concatenate([once[2], twice[2]]),
-        rows[later], (lo[later], hi[later]),
+        rows[later], (lo[later], hi[later]), *pieces, rows[small & edge],
     )  # fmt: skip
 
 
@@ -526,18 +571,19 @@ def _floor(dd: Interval, min_width: float) -> np.ndarray:
     return np.maximum(np.minimum(min_width, 0.01 * shortest), ROOT_FLOOR)
 
 
-def _split(lo: np.ndarray, hi: np.ndarray, parent: np.ndarray) -> tuple:
+def _split(lo: np.ndarray, hi: np.ndarray, parent: np.ndarray, free=None) -> tuple:
     """Each box halved along its MAX_CUTS widest sides (those at least half as wide as its
     widest): (lo, hi, the `parent` of each half's box). In six or eight dimensions a box cut
     along every side makes 64 or 256 boxes where the first halvings would often have excluded
-    half of them (prism_slack: 15.8 million boxes -> 2.6 million)."""
+    half of them (prism_slack: 15.8 million boxes -> 2.6 million). A free angle of the
+    batch's box `parent` (`free`, (batch, n)) is never halved: grad V is 0 along it."""
     if not len(lo):
         return lo, hi, parent
-    w = hi - lo
+    w = hi - lo if free is None else np.where(free[parent], 0.0, hi - lo)
     widest = np.argsort(-w, axis=1, kind="stable")[:, :MAX_CUTS]
     cut = np.zeros(w.shape, dtype=bool)
     np.put_along_axis(cut, widest, True, axis=1)
-    cut &= w >= 0.5 * w.max(axis=1, keepdims=True)
+    cut &= (w >= 0.5 * w.max(axis=1, keepdims=True)) & (w > 0)
     for j in range(lo.shape[1]):
         c = cut[:, j]
         mid = 0.5 * (lo[c, j] + hi[c, j])
@@ -551,13 +597,24 @@ def _split(lo: np.ndarray, hi: np.ndarray, parent: np.ndarray) -> tuple:
     return lo, hi, parent
 
 
-def krawczyk(land: BoxLandscape, lo: np.ndarray, hi: np.ndarray, states) -> tuple:
-    """(verdict, K lo, K hi) per box: 1 exactly one critical point (in K), -1 none, 0 unknown."""
+def krawczyk(land: BoxLandscape, lo: np.ndarray, hi: np.ndarray, states, free=None) -> tuple:
+    """(verdict, K lo, K hi) per box: 1 exactly one critical point (in K), -1 none, 0 unknown.
+    Along `free` angles ((B, n) bool) grad V is 0 whatever they are: the test is that of the
+    other components in the other angles (their gradient does not depend on the free ones over
+    the box), and a 1 says each value of the free angles has exactly one critical point of the
+    others, the same one (the free angles of K are the box's middle)."""
     n = lo.shape[1]
-    box = Interval(lo, hi)
     mid = 0.5 * (lo + hi)
     _, g_mid, _ = land.enclose(Interval(mid))
-    h = land.hessian(box, states)
+    h = land.hessian(Interval(lo, hi), states)
+    if free is None or not free.any():
+        free = np.zeros(lo.shape, dtype=bool)
+    else:
+        both = ~free[:, :, None] & ~free[:, None, :]
+        eye = np.broadcast_to(np.eye(n), both.shape)
+        h = Interval(np.where(both, h.lo, eye), np.where(both, h.hi, eye))
+        g_mid = Interval(np.where(free, 0.0, g_mid.lo), np.where(free, 0.0, g_mid.hi))
+    box = Interval(np.where(free, mid, lo), np.where(free, mid, hi))
     h_mid = h.mid
     ok = np.isfinite(h_mid).all(axis=(1, 2)) & g_mid.finite().all(axis=1)
     ok &= np.abs(np.linalg.det(np.where(ok[:, None, None], h_mid, np.eye(n)))) > 1e-300
@@ -571,8 +628,8 @@ def krawczyk(land: BoxLandscape, lo: np.ndarray, hi: np.ndarray, states) -> tupl
     tail = (spread * Interval(dx.lo[:, None, :], dx.hi[:, None, :])).isum(axis=2)
     k = (Interval(mid) - yg) + tail
     ok &= k.finite().all(axis=1)
-    inside = ok & ((k.lo > lo) & (k.hi < hi)).all(axis=1)
-    apart = ok & ((k.hi < lo) | (k.lo > hi)).any(axis=1)
+    inside = ok & (((k.lo > lo) & (k.hi < hi)) | free).all(axis=1)
+    apart = ok & (((k.hi < lo) | (k.lo > hi)) & ~free).any(axis=1)
     verdict = np.where(inside, 1, np.where(apart, -1, 0))
     return verdict, k.lo, k.hi
 
@@ -596,6 +653,28 @@ def _roots(land: BoxLandscape, lo, hi, k_lo, k_hi, steps: int = 40) -> tuple:
         done[live[small | ~inside]] = True
     good = ((x >= a) & (x <= b)).all(axis=1)
     return x, np.hstack([lo, hi]), good
+
+
+def _free(land, states, shape: tuple) -> np.ndarray:
+    """(B, n) the angles grad V is 0 along whatever they are, over each box (landscape.free)."""
+    rule = getattr(land, "free", None)
+    return np.zeros(shape, dtype=bool) if rule is None else rule(states, shape[0])
+
+
+def _free_points(land, lo, hi, k_lo, k_hi, free, steps: int = 40) -> np.ndarray:
+    """The critical point of the other angles each free box holds alone (Newton on them from
+    the middle of K n X), the free angles at the box's middle."""
+    a, b = np.maximum(lo, k_lo), np.minimum(hi, k_hi)
+    x = np.where(free, 0.5 * (lo + hi), 0.5 * (a + b))
+    n = lo.shape[1]
+    both = ~free[:, :, None] & ~free[:, None, :]
+    for _ in range(steps):
+        g, h = point_derivatives(land, x)
+        h = np.where(both, h, np.eye(n))
+        new = x - np.nan_to_num(_newton_steps(h, np.where(free, 0.0, g)))
+        inside = ((new >= a) & (new <= b)).all(axis=1)
+        x = np.where(inside[:, None], new, x)
+    return x
 
 
 def _newton_steps(h: np.ndarray, g: np.ndarray) -> np.ndarray:

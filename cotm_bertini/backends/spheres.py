@@ -34,11 +34,12 @@ from ..model.framework.reach import sphere_chain
 from ..model.framework.spec import Framework, owner
 from ..model.framework.units import normalized_slots
 from ..model.intervals import Interval, stack
-from .boxes import OFFSET
+from .boxes import EDGE, FREE, OFFSET
 from .endpoints import Endpoints
 from .links import (
     EITHER,
     SLACK,
+    TAUT,
     columns,
     force_density,
     found_endpoints,
@@ -121,6 +122,9 @@ class SphereFramework:
         if self.coords != list(range(self.full.local_size)):
             raise ValueError(f"{fw.name}: node coordinates are not the local coordinates")
         self.stencil = self._stencil()
+        # Each link's ends that are nodes: (node index, +1 for end a / -1 for end b).
+        self.ends = [[(j, int(np.sign(st[0, 3 * j]))) for j in range(len(self.nodes))
+                      if st[0, 3 * j]] for st in self.stencil]  # fmt: skip
 
     def renumber(self, slots: dict | None = None) -> None:
         """The numbers taken from normalised `slots` (default: the framework's): the
@@ -143,6 +147,36 @@ class SphereFramework:
         lo = np.array([[v for i in row for v in (parts[i][0][0], parts[i][1][0])] for row in idx])
         hi = np.array([[v for i in row for v in (parts[i][0][1], parts[i][1][1])] for row in idx])
         return lo, hi
+
+    def free(self, states: dict, count: int) -> np.ndarray:
+        """(B, n) per chart angle over each box: FREE where grad V is 0 along it whatever it
+        is (a node's two angles, where every element joining what hangs from it to the rest is
+        a cable that is slack over the box and no load acts on what hangs from it: V is flat
+        there), EDGE where that node may be so (no such cable certainly taut), else 0."""
+        out = np.zeros((count, self.n), dtype=np.int8)
+        for i, cables in self._floating().items():
+            slack, loose = np.ones(count, dtype=bool), np.ones(count, dtype=bool)
+            for c in cables:
+                slack &= states[c] == SLACK
+                loose &= states[c] != TAUT
+            out[:, 2 * i : 2 * i + 2] = np.where(slack, FREE, np.where(loose, EDGE, 0))[:, None]
+        return out
+
+    def _floating(self) -> dict[int, list[str]]:
+        """Per node that can float: the cables whose slackness frees it (module `free`)."""
+        touches = [set(np.flatnonzero(np.abs(s).sum(axis=0)) // 3) for s in self.stencil]
+        loaded = {ld.point for ld in self.fw.loads
+                  if any(self.slots[f"f_{ld.name}_{c}"] for c in "xyz")}  # fmt: skip
+        out = {}
+        for i, v in enumerate(self.nodes):
+            hang = set(self.subtree(v))
+            if loaded & {self.nodes[j] for j in hang}:
+                continue
+            crossing = [x for x, t in zip(self.links, touches, strict=True)
+                        if t & hang and (len(t) == 1 or not t <= hang)]  # fmt: skip
+            if all(x.cable and x.L0 is not None for x in crossing):
+                out[i] = [x.name for x in crossing]
+        return out
 
     def subtree(self, node: str) -> list[int]:
         """Indices of the nodes that hang from `node` (itself included)."""
@@ -260,24 +294,18 @@ class SphereFramework:
         cable off.) Loads are linear in X and bars are the charts: neither adds a term."""
         first = ball_module(self.full).first_order(self.pose(positions, count), self.P)
         m, per = len(positions), 3 + 3 * len(positions)
-        acc: dict[tuple[int, int], Interval] = {}
+        blocks: dict[tuple[int, int], Interval] = {}
         for i, x in enumerate(self.links):
-            r = [Interval(np.zeros(count)) + first[i * per + c] for c in range(3)]
-            block = _link_block(x, r)
-            for c in range(3):
-                for e in range(3):
-                    if block[c][e] is None:
-                        continue
-                    for j in np.flatnonzero(self.stencil[i, c]):
-                        for q in np.flatnonzero(self.stencil[i, e]):
-                            if q < j:
-                                continue
-                            t = block[c][e] * float(self.stencil[i, c, j] * self.stencil[i, e, q])
-                            acc[j, q] = t if (j, q) not in acc else acc[j, q] + t
+            r = stack([Interval(np.zeros(count)) + first[i * per + c] for c in range(3)], axis=1)
+            M = _link_block(x, r)
+            for j, sj in self.ends[i]:
+                for q, sq in self.ends[i]:
+                    t = M if sj == sq else -M
+                    blocks[j, q] = t if (j, q) not in blocks else blocks[j, q] + t
         lo, hi = np.zeros((count, m, m)), np.zeros((count, m, m))
-        for (j, q), t in acc.items():
-            lo[:, j, q], hi[:, j, q] = t.lo, t.hi
-            lo[:, q, j], hi[:, q, j] = t.lo, t.hi
+        for (j, q), t in blocks.items():
+            lo[:, 3 * j : 3 * j + 3, 3 * q : 3 * q + 3] = t.lo
+            hi[:, 3 * j : 3 * j + 3, 3 * q : 3 * q + 3] = t.hi
         return Interval(lo, hi)
 
     def _curvature(self, out, g: list, dirs: list, count: int):
@@ -424,27 +452,30 @@ class SphereFramework:
         return found_endpoints(fs.ps.variables, values, np.arange(len(X)))
 
 
-def _link_block(x, r: list) -> list[list]:
-    """The Hessian of a link's energy in its r = a - b over boxes (3 x 3 Intervals, None for
-    a term that is 0): k I without a free length; else w I + k L0 r r^T / d^3, w the force
-    density; a cable's terms hulled with 0 where it may be slack, 0 where it is."""
+def _link_block(x, r: Interval) -> Interval:
+    """The Hessian of a link's energy in its r = a - b over boxes (B, 3) -> (B, 3, 3): k I
+    without a free length; else w I + k L0 r r^T / d^3, w the force density; a cable's r r^T
+    term hulled with 0 where it may be slack, 0 where it is (w is so already)."""
+    eye = np.eye(3)[None]
     if x.L0 is None:
-        return [[Interval(np.full(r[0].lo.shape, x.k)) if c == e else None for e in range(3)]
-                for c in range(3)]  # fmt: skip
-    dd = interval_sum(c.square() for c in r)
+        return Interval(np.broadcast_to(x.k * eye, (r.lo.shape[0], 3, 3)).copy())
+    dd = r.square().isum(axis=1)
     w, state = force_density(x, dd)
     t = (x.k * x.L0) / (dd.sqrt() * dd)
-    out = [[(r[c].square() if c == e else r[c] * r[e]) * t for e in range(3)] for c in range(3)]
+    outer = Interval(r.lo[:, :, None], r.hi[:, :, None]) * Interval(
+        r.lo[:, None, :], r.hi[:, None, :]
+    )
+    diag = r.square()  # tighter than r_c r_c
+    ii = np.arange(3)
+    outer.lo[:, ii, ii], outer.hi[:, ii, ii] = diag.lo, diag.hi
+    T = outer * Interval(t.lo[:, None, None], t.hi[:, None, None])
     if x.cable:
-        slack, either = state == SLACK, state == EITHER
-        for row in out:
-            for e, v in enumerate(row):
-                lo = np.where(slack, 0.0, np.where(either, np.minimum(v.lo, 0.0), v.lo))
-                hi = np.where(slack, 0.0, np.where(either, np.maximum(v.hi, 0.0), v.hi))
-                row[e] = Interval(lo, hi)
-    for c in range(3):
-        out[c][c] = out[c][c] + w
-    return out
+        slack, either = (state == SLACK)[:, None, None], (state == EITHER)[:, None, None]
+        T = Interval(
+            np.where(slack, 0.0, np.where(either, np.minimum(T.lo, 0.0), T.lo)),
+            np.where(slack, 0.0, np.where(either, np.maximum(T.hi, 0.0), T.hi)),
+        )
+    return T + Interval(w.lo[:, None, None] * eye, w.hi[:, None, None] * eye)
 
 
 def _dot(u: list, v: list):

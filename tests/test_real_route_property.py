@@ -1,0 +1,70 @@
+"""The real route's proofs against independent searches, on random mechanisms of each kind it
+covers (tests/random_mechanisms.py: planar chains on tori, nodes hanging from bars on products
+of spheres; cables that go slack, loads in every direction). Each mechanism is written twice,
+as a framework file and as plain numpy statics that share no code with the package; Newton
+from thousands of random starts finds the statics' critical points. A proved search must hold
+every one of them (pose to 1e-7, Morse index, energy) and nothing else. A few mechanisms run in
+`make test`, many in `make stress` (COTM_STRESS=full)."""
+
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+import pytest
+import random_mechanisms as rm
+import tensegrity_physics as tp
+
+import cotm_bertini as cb
+
+FULL = os.environ.get("COTM_STRESS") == "full"
+CHAINS = [(s, 2 + s % 2) for s in range(40 if FULL else 3)]
+HANGING = [(s, 2 + (s % 3 == 2)) for s in range(24 if FULL else 2)]
+
+
+def _solve(text: str, tmp_path, name: str):
+    path = tmp_path / f"{name}.toml"
+    path.write_text(text)
+    res = cb.solve(cb.Framework.from_toml(path), route="real", cache=False)
+    assert res.status == "ok", res.warnings
+    assert res.record["details"]["real_search"]["undecided"] == 0
+    return res
+
+
+@pytest.mark.parametrize(("seed", "links"), CHAINS)
+def test_a_random_planar_chain_proved_holds_every_newton_point(seed, links, tmp_path):
+    """A chain of two or three links with springs, cables and loads: the proved rows are the
+    critical points Newton finds on the statics written here, no more, no fewer."""
+    ch = rm.planar_chain(seed, links)
+    ref = rm.chain_critical_points(ch)
+    res = _solve(ch.toml(f"chain_{seed}"), tmp_path, f"chain_{seed}")
+    rows = res.physical
+    angles = np.radians(rows[[f"link{i + 1}.angle_deg" for i in range(links)]].to_numpy(float))
+    assert len(rows) == len(ref), (len(rows), len(ref))
+    for p in ref:
+        gap = np.abs((angles - p["angles"] + math.pi) % (2 * math.pi) - math.pi).max(axis=1)
+        (i,) = np.flatnonzero(gap < 1e-7)
+        row = rows.iloc[i]
+        assert math.isclose(float(row["energy"]), p["energy"], rel_tol=1e-9, abs_tol=1e-9)
+        if not p["degenerate"]:
+            assert int(row["index"]) == p["index"]
+
+
+@pytest.mark.parametrize(("seed", "nodes"), HANGING)
+def test_random_hanging_nodes_proved_hold_every_newton_point(seed, nodes, tmp_path):
+    """Two or three nodes hanging by bars, cables among them and to the ground, a load on each
+    node in a random direction: the proved rows are the critical points Newton finds on the
+    Lagrange conditions of tensegrity_physics (every taut set), no more, no fewer."""
+    hn = rm.hanging_nodes(seed, nodes)
+    ref = tp.critical_points(hn.spatial, starts=600 if nodes == 2 else 1500, seed=seed)
+    res = _solve(hn.toml(f"hanging_{seed}"), tmp_path, f"hanging_{seed}")
+    rows, free = res.physical, hn.spatial.free
+    X = rows[[f"{n}.{c}" for n in free for c in "xyz"]].to_numpy(float)
+    assert len(rows) == len(ref), (len(rows), len(ref))
+    for p in ref:
+        (i,) = np.flatnonzero(np.abs(X - p["X"]).max(axis=1) < 1e-7)
+        row = rows.iloc[i]
+        assert math.isclose(float(row["energy"]), p["energy"], rel_tol=1e-9, abs_tol=1e-9)
+        if p["index"] >= 0:
+            assert int(row["index"]) == p["index"]

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 from pathlib import Path
 
 import pandas as pd
@@ -247,3 +249,19 @@ def test_second_identical_request_is_answered_from_the_cache(tmp_path):
     assert "cache: answered" not in third.stderr
     changed = cli(*args, "--set", "L01=11.4")
     assert "cache: answered" not in changed.stderr
+
+
+def test_a_cold_solve_from_a_warm_cache_imports_no_sympy(tmp_path):
+    """`solve case3 --no-cache` in a fresh process, once the derived equations and the generic
+    set are cached: the compiled system serves, so sympy (~0.3 s to import) is never loaded."""
+    code = (
+        "import sys\n"
+        "from cotm_bertini.cli import main\n"
+        f"rc = main(['solve', 'case3', '--no-cache', '--no-plots', '--quiet', '--out', "
+        f"{str(tmp_path)!r}])\n"
+        "print(rc, 'sympy' in sys.modules)\n"
+    )
+    warm = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert warm.returncode == 0, warm.stderr
+    cold = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert cold.stdout.split()[-2:] == ["0", "False"], cold.stdout + cold.stderr

@@ -275,6 +275,7 @@ def test_a_cold_solve_from_a_warm_cache_imports_no_sympy(tmp_path):
         (["map", "--param", "x", "--fro2=1"], "unknown option --fro2 (did you mean --from2?)"),
         (["solve", "--xyzzy"], "unknown option --xyzzy (`cotm-bertini solve --help` lists them)"),
         (["solv", "case3"], "unknown command 'solv' (did you mean solve?)"),
+        (["--verison"], "unknown option --verison (did you mean --version?)"),
     ],
 )
 def test_an_unknown_option_is_named_with_the_nearest_known_one(tmp_path, capsys, args, line):

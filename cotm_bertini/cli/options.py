@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import difflib
 import re
+import sys
 from pathlib import Path
 
 from ..errors import ParameterError
@@ -35,8 +36,10 @@ class Parser(argparse.ArgumentParser):
 
     def parse_known_args(self, args=None, namespace=None):
         """argparse's, after each --option of a command is checked against its known ones."""
-        if args is not None and self._subparsers is None:  # a command's own options
-            unknown_option(self, list(args))
+        if args is None and self._subparsers is not None:
+            args = sys.argv[1:]
+        if args is not None:  # the command's own options, or those before the command
+            unknown_option(self, list(args), self._subparsers is not None)
         return super().parse_known_args(args, namespace)
 
     def error(self, message: str) -> None:
@@ -54,19 +57,21 @@ def _nearest(word: str, known: list[str]) -> str:
     return f" (did you mean {close[0]}?)" if close else ""
 
 
-def unknown_option(parser: argparse.ArgumentParser, args: list[str]) -> None:
+def unknown_option(parser: argparse.ArgumentParser, args: list[str], top: bool = False) -> None:
     """Refuse a --option the command does not know (argparse would take its value for the
     case, or say only "unrecognized arguments"), naming the nearest known one. An unambiguous
-    prefix of a known option is argparse's to accept."""
+    prefix of a known option is argparse's to accept. `top`: the program's own options, those
+    before the command."""
     known = [s for s in parser._option_string_actions if s.startswith("--")]
     for arg in args:
-        if arg == "--":  # the rest are values
+        if arg == "--" or (top and not arg.startswith("-")):  # the rest: values, or a command's
             return
         if not arg.startswith("--"):
             continue
         name = arg.split("=", 1)[0]
         if not any(k.startswith(name) for k in known):
-            where = f" (`{parser.prog} --help` lists them)"
+            where = (" (a command's options go after it: `cotm-bertini COMMAND --help`)" if top
+                     else f" (`{parser.prog} --help` lists them)")  # fmt: skip
             parser.error(f"unknown option {name}{_nearest(name, known) or where}")
 
 

@@ -7,7 +7,9 @@
 5. stage profile of `make case3`                                      bench/stage_profile.py
 6. speed side by side: the paper's sweep by four routes, one solve, the 101 x 101 grid
                                                                      bench/speed.py
-7. a summary of the headline figures
+7. the cold solve of case 3 against bare bertini2 on case 3, interleaved
+                                                                     bench/cold_solve.py
+8. a summary of the headline figures
 
 Benchmarks, not tests: nothing is asserted; targets are printed beside the measurements.
 Timings are wall clock on whatever else the machine is doing: run it on a quiet machine.
@@ -39,7 +41,7 @@ def _pareto_settings(grid_table, column: str) -> dict[str, list[str]]:
 
 
 def summary(results: dict, failed: list[str], elapsed: float) -> None:
-    """Section 6: the headline figures against their targets; summary.csv."""
+    """Section 8: the headline figures against their targets; summary.csv."""
     import pandas as pd
     from benchlib import show, write_csv
 
@@ -90,9 +92,16 @@ def summary(results: dict, failed: list[str], elapsed: float) -> None:
     if grid is not None:
         add("101 x 101 grid (2 workers)", grid["seconds"], "s", "< 120 s", grid["seconds"] < 120)
         add("  lost paths", grid["lost_paths"], "")
+    cold = results.get("cold")
+    if cold is not None:
+        add("cold solve case3 --no-cache --no-plots (fresh process, median of 5)",
+            cold["cold solve case3 --no-cache --no-plots (s, median)"], "s")  # fmt: skip
+        add("  / bare bertini2 case3 (same run)", cold["cold solve / bare bertini2"], "x")
+        add("  sympy imported (1: yes, 0: no)", int(cold["sympy imported"]), "", "0",
+            not cold["sympy imported"])  # fmt: skip
     add("bench wall time (run_all.py)", elapsed, "s", "< 600 s", elapsed < 600)
     frame = pd.DataFrame(rows)
-    show("6. Summary", frame, {"value": ".4g"})
+    show("8. Summary", frame, {"value": ".4g"})
     if grid is not None:
         for column, what in (("worst_err_deg", "reported"), ("raw_err_deg", "raw endpoints")):
             fronts = _pareto_settings(table, column)
@@ -114,6 +123,7 @@ def main() -> int:
     args = ap.parse_args()
     start = time.perf_counter()
 
+    import cold_solve
     import formulations
     import peers
     import reference
@@ -151,6 +161,7 @@ def main() -> int:
     if "speed" in results:
         speed.plot_series(results["speed"], speed.RESULTS / "speed.png")
     section("solve", speed.one_solve)
+    section("cold", cold_solve.run)
     if not args.quick:
         section("grid101", speed.grid)
     summary(results, failed, time.perf_counter() - start)

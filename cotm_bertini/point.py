@@ -209,7 +209,6 @@ def _paper_real(params: Params, settings: Settings, tolerances: Tolerances, t: T
     the paper's own system (c, s and the spring lengths d), so that it is refined, classified
     and Morse-checked as Bertini's endpoints are. The framework's own warnings (undecided
     boxes, its Morse count from the search's cone points) are kept beside the paper's checks."""
-    from .model.equations import variables_for
     from .model.framework.paper import ANGLE_COLUMNS, paper_framework
     from .model.kinematics import spring_vectors
 
@@ -219,7 +218,8 @@ def _paper_real(params: Params, settings: Settings, tolerances: Tolerances, t: T
     vec = spring_vectors(params, c1, s1, c2, s2)
     value = {"c1": c1, "s1": s1, "c2": c2, "s2": s2,
              "d1": np.hypot(*vec["spring1"]), "d2": np.hypot(*vec["spring2"])}  # fmt: skip
-    variables = variables_for(params.zfl)
+    # The compiled system's variables (variables_for's), read without importing sympy.
+    variables = parametric_system(params.zfl).variables
     n = len(g1)
     records = [{"coords": [value[v][k] for v in variables], "path_number": k} for k in range(n)]
     endpoints = Endpoints.from_records(variables, records)

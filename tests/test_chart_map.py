@@ -150,3 +150,19 @@ def test_zeeman_pitchforks_break_the_mirror_and_folds_do_not(zeeman_map):
             ev, vec = np.linalg.eigh(null.T @ H[0] @ null)
             soft = null @ vec[:, np.argmin(np.abs(ev))]
             assert (abs(soft[1]) > 0.99) == along_y, (kind, row.x, row.y, soft)
+
+
+def test_the_propagation_never_goes_silent(monkeypatch, capfd):
+    """Issue 46: a map went silent for minutes after its anchors; the propagation (and the
+    curves and the classification after it) report how far they got, line by line."""
+    from cotm_bertini import progress
+
+    monkeypatch.setenv(progress.ENV_DELAY, "0")
+    monkeypatch.setenv(progress.ENV_SECONDS, "0")
+    fw = cb.Framework.from_toml(SPHERE)
+    cb.design_map(fw, *WINDOW, points=3, grid="continuation")
+    err = capfd.readouterr().err
+    followed = [ln for ln in err.splitlines() if ln.startswith("map: equilibria followed")]
+    assert followed and "grid lines," in followed[-1], err
+    assert "9/9 grid points reached" in followed[-1] and "0 lines to pass" in followed[-1]
+    assert "map: grid points classified: 9/9 points" in err

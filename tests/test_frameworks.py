@@ -187,6 +187,50 @@ def test_bad_framework_files_name_the_element(tmp_path, edit, words):
         assert word in message, message
 
 
+LOAD = '[[loads]]\nname = "wA"\npoint = "w.r"\nforce = [0.0, -0.1]\n'
+
+
+@pytest.mark.parametrize(
+    "edit, line",
+    [
+        ((LOAD, LOAD.replace("force =", "forces =")),
+         "loads[1] (wA): unknown key 'forces' (did you mean 'force'?)"),
+        ((LOAD, LOAD.replace('name = "wA"\n', "").replace("point", "pont")),
+         "loads[1]: unknown key 'pont' (did you mean 'point'?)"),
+        (("L0 = 0.5", "LO = 0.5"), "springs[1]: unknown key 'LO' (did you mean 'L0'?)"),
+        (("k = 1.0", 'name = "s"\nk = 1.0\nstiff = 2'),
+         "springs[1] (s): unknown key 'stiff' (known: L0, a, b, k, name)"),
+        (('b = "ground.c"', 'b = "ground.c"\nc = "w.r"'),
+         "pins[1]: unknown key 'c' (known: a, b)"),
+        (("[[springs]]", "[[sprngs]]"),
+         "the framework file's top level: unknown key 'sprngs' (did you mean 'springs'?)"),
+        (('name = "t"', 'name = "t"\ndimension = 2'),
+         "the framework file's top level: unknown key 'dimension' (did you mean 'dim'?)"),
+        (("[[springs]]", '[[bars]]\na = "w.r"\nb = "ground.u"\nlenght = 1.0\n[[springs]]'),
+         "bars[1]: unknown key 'lenght' (did you mean 'length'?)"),
+    ],
+)  # fmt: skip
+def test_an_unknown_key_is_named_with_its_table_and_the_nearest_known_key(tmp_path, edit, line):
+    """Issue 46: `forces = [...]` in a load was answered "needs point and force"; a misspelt
+    key of any table is named, with its element and the key it was probably meant to be."""
+    text = (BASE + LOAD).replace(*edit)
+    assert text != BASE + LOAD
+    with pytest.raises(ParameterError) as err:
+        cb.Framework.from_toml(_write(tmp_path, text))
+    assert str(err.value) == line
+
+
+def test_an_unknown_key_on_the_command_line_is_one_line_exit_2(tmp_path):
+    from conftest import run_cli
+
+    path = _write(tmp_path, BASE + LOAD.replace("force =", "forces ="))
+    r = run_cli("solve", "--framework", str(path), "--out", str(tmp_path / "out"))
+    assert r.returncode == 2 and not (tmp_path / "out").exists(), r.stderr
+    assert r.stderr == (
+        "cotm-bertini: error: loads[1] (wA): unknown key 'forces' (did you mean 'force'?)\n"
+    )
+
+
 def test_duplicate_names_are_refused(tmp_path):
     text = BASE + '[[springs]]\nname = "spring1"\na = "w.r"\nb = "ground.c"\nk = 1.0\nL0 = 0.1\n'
     with pytest.raises(ParameterError, match="spring1"):

@@ -75,6 +75,21 @@ def test_sin_sees_the_crest_inside_an_interval():
     assert s.hi[0] == 1.0 and s.hi[1] == 1.0 and s.lo[2] == -1.0
 
 
+def test_an_unbounded_interval_warns_nothing_and_reads_as_not_finite():
+    """Issue 46: a map printed numpy's raw `invalid value encountered in add` (the midpoint of
+    [-inf, inf], a Krawczyk step's Hessian): the outcome, NaN, is "not finite" to its callers,
+    so it is computed without a warning; so is 0 to a negative real power (unbounded)."""
+    import warnings
+
+    whole = Interval(np.array([-np.inf, 1.0]), np.array([np.inf, 3.0]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        mid = whole.mid
+        power = Interval(np.array([0.0, 1.0]), np.array([0.0, 4.0])) ** -0.5
+    assert np.isnan(mid[0]) and mid[1] == 2.0 and not np.isfinite(mid).all()
+    assert power.hi[0] == np.inf and not power.finite()[0] and power.finite()[1]
+
+
 def test_a_number_per_box_is_exact_where_one_given_alone_is():
     """Numbers per box (a family's parameters, search_each) give each box the bounds the same
     number alone gives it: x * 1 and x + 0 stay exact (not widened by an ulp), any other

@@ -56,6 +56,7 @@ def test_3_failed_completeness_check_is_incomplete_exit_5(tmp_path):
     r = cli("solve", "case2", "--set", "L01=11.012830665", "--no-plots", "--out", str(tmp_path))
     assert r.returncode == 5, r.stderr
     assert "equilibria may be missing" in r.stderr
+    assert r.stdout.strip().splitlines()[-1].startswith("status incomplete (exit 5): a complete")
     rec = json.loads((tmp_path / "latest" / "run.json").read_text())
     assert rec["status"] == "incomplete" and rec["morse"]["ok"] is False
     assert any("equilibria may be missing" in w for w in rec["warnings"])
@@ -70,6 +71,9 @@ def test_4_path_accounting_has_no_negative_counts(tmp_path):
     assert c["finite_endpoints"] + c["infinite_or_failed_paths"] == c["paths_tracked"]
     assert c["closed_form_endpoints"] > 0
     assert f"{c['finite_endpoints']} finite endpoints of {c['paths_tracked']} paths" in r.stdout
+    # An ok run says so too, as its last line (issue 46): not only in run.json.
+    last = r.stdout.strip().splitlines()[-1]
+    assert last == "status ok (exit 0): every completeness check passed"
 
 
 def test_5_a_params_file_labels_the_run(tmp_path):
@@ -82,6 +86,29 @@ def test_5_a_params_file_labels_the_run(tmp_path):
     assert json.loads((run / "run.json").read_text())["label"] == "soft-springs"
     only_set = cli("solve", "--set", "k1=1.5", "--no-plots", "--quiet", cwd=tmp_path)
     assert (tmp_path / only_set.stdout.strip()).parent == tmp_path / "runs" / "custom"
+    # --quiet: stdout is the folder alone, the status line goes to stderr.
+    assert only_set.stderr.strip().splitlines()[-1].startswith("status ok (exit 0)")
+
+
+def test_5b_every_exit_code_of_a_solve_has_its_status_line():
+    """ok, incomplete and contradiction, each named with its exit code and what it means."""
+    from types import SimpleNamespace
+
+    from cotm_bertini.cli.commands import _exit_code, _status_line
+
+    cases = [
+        ("ok", None, 0),
+        ("incomplete", None, 5),
+        ("ok", "proved", 0),
+        ("ok", "rows proved", 0),
+        ("ok", "undecided", 5),
+        ("ok", "contradiction", 4),
+    ]
+    for status, cert, code in cases:
+        got = _exit_code(status, None if cert is None else SimpleNamespace(status=cert))
+        assert got == code, (status, cert)
+    assert _status_line(4).startswith("status contradiction (exit 4): the certificate")
+    assert _status_line(5).startswith("status incomplete (exit 5): a completeness check failed")
 
 
 @pytest.mark.parametrize(

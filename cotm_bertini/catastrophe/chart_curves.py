@@ -35,6 +35,7 @@ from ..continuation.charts import FD, FD_ANGLE, ChartPlane, _distance
 from ..errors import ParameterError
 from ..model.framework.compiled import framework_system
 from ..model.framework.spec import units
+from ..progress import Progress
 from ..settings import Tolerances
 from .curve_trace import Equations, Window, newton, one_way, remembered, tangent
 from .framework_folds import _cusps, _empty, _solution_columns
@@ -324,17 +325,21 @@ def chart_fold_curves(plane: ChartPlane, seeds, xrange: tuple[float, float],
     win = Window(n, n + 1, (xrange[0], yrange[0]), (xrange[1], yrange[1]), (1.0, 1.0))
     curves: list[_Curve] = []
     counts = {"seeds_on_traced": 0, "seeds_outside": 0, "seeds_not_refined": 0}
-    for seed in seeds:
-        z = _polish(plane, seed, _equations(plane, seed))
-        same = [c for c in curves if (c.seed.kind, c.seed.cable) == (seed.kind, seed.cable)]
-        if z is None:
-            counts["seeds_not_refined"] += 1
-        elif not win.inside(z, 1e-9):
-            counts["seeds_outside"] += 1
-        elif any(_near(plane, c.points, z, win, spacing, ON_CURVE).any() for c in same):
-            counts["seeds_on_traced"] += 1
-        else:
-            curves.append(_trace(plane, seed, z, win, spacing))
+    # A curve's trace can take tens of seconds: a heartbeat between seeds (silent if short).
+    with Progress("map: curves traced from the seeds", len(seeds), "seeds",
+                  heartbeat=True) as report:  # fmt: skip
+        for seed in seeds:
+            z = _polish(plane, seed, _equations(plane, seed))
+            same = [c for c in curves if (c.seed.kind, c.seed.cable) == (seed.kind, seed.cable)]
+            if z is None:
+                counts["seeds_not_refined"] += 1
+            elif not win.inside(z, 1e-9):
+                counts["seeds_outside"] += 1
+            elif any(_near(plane, c.points, z, win, spacing, ON_CURVE).any() for c in same):
+                counts["seeds_on_traced"] += 1
+            else:
+                curves.append(_trace(plane, seed, z, win, spacing))
+            report.update(1, f"{len(curves)} curves")
     traced = time.perf_counter()
     table, about = _rows(plane, curves, win)
     warnings = [f"{counts['seeds_not_refined']} seeds did not converge onto a curve"] * bool(

@@ -27,6 +27,7 @@ import numpy as np
 
 from ..continuation.charts import ChartPlane, advance
 from ..model.framework.spec import Framework
+from ..progress import Progress
 from .chart_curves import Seed
 from .curve_trace import Window, one_way, tangent, turning_point
 
@@ -58,21 +59,35 @@ def anchor_indices(points: int, per_axis: int = ANCHORS) -> list[int]:
     return sorted({int(round(v)) for v in np.linspace(0, points - 1, min(per_axis, points))})
 
 
-def propagate(plane: ChartPlane, xs: np.ndarray, ys: np.ndarray, known: dict,
-              progress=None) -> _State:  # fmt: skip
+PROPAGATION = "map: equilibria followed over the grid"
+
+
+def propagate(plane: ChartPlane, xs: np.ndarray, ys: np.ndarray, known: dict) -> _State:
     """Followed to a fixed point: every equilibrium of `known` ({(i, j): (m, n) chart points})
     along its row and column (module docstring, 2); `known` grows in place."""
     state = _State(known)
     for i, j in known:
         state.dirty |= {(0, j), (1, i)}
-    while state.dirty:
-        axis, index = min(state.dirty)
-        state.dirty.discard((axis, index))
-        _line(plane, state, axis, index, xs, ys)
-        state.passes += 1
-        if progress is not None:
-            progress(state)
+    # Minutes on a spatial framework: reported as lines are passed, and every few seconds
+    # (heartbeat) while one line's steps through folds run; no total (a line passed can make
+    # crossing lines dirty again), so the note says how far the grid is filled.
+    with Progress(PROPAGATION, None, "grid lines", heartbeat=True) as report:
+        while state.dirty:
+            axis, index = min(state.dirty)
+            state.dirty.discard((axis, index))
+            _line(plane, state, axis, index, xs, ys)
+            state.passes += 1
+            report.update(1, _followed(state, len(xs) * len(ys)))
     return state
+
+
+def _followed(state: _State, points: int) -> str:
+    """The propagation's progress note: grid points reached, equilibria, lines left, lost."""
+    reached = sum(len(v) > 0 for v in state.known.values())
+    found = sum(len(v) for v in state.known.values())
+    return (f"{reached}/{points} grid points reached, {found} equilibria, "
+            f"{state.throughs} steps through folds, {len(state.lost)} branches lost, "
+            f"{len(state.dirty)} lines to pass")  # fmt: skip
 
 
 def _params(axis: int, index: int, k: int, xs, ys) -> np.ndarray:

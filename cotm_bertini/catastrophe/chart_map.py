@@ -15,7 +15,7 @@ import pandas as pd
 from ..backends.pools import worker_pool
 from ..continuation.charts import ChartPlane
 from ..model.framework.spec import Framework
-from ..progress import say
+from ..progress import Progress, say
 from ..settings import Settings, Tolerances
 from .chart_curves import chart_fold_curves
 from .chart_grid import ANCHORS, anchor_jobs, anchor_task, propagate
@@ -92,6 +92,7 @@ def _grid_rows(fw: Framework, plane: ChartPlane, x: str, xs, y: str, ys, known: 
     from ..point import real_table
 
     frames, failed = [], []
+    report = Progress("map: grid points classified", len(xs) * len(ys), "points")
     for i, xv in enumerate(xs):
         for j, yv in enumerate(ys):
             fwp = fw.replace(**{x: float(xv), y: float(yv)})
@@ -107,4 +108,6 @@ def _grid_rows(fw: Framework, plane: ChartPlane, x: str, xs, y: str, ys, known: 
             frame.insert(0, x, float(xv))
             frame.insert(0, "point", i * len(ys) + j)
             frames.append(frame)
+            report.update(1)
+    report.close()
     return pd.concat(frames, ignore_index=True), failed

@@ -75,12 +75,42 @@ def solve(args: argparse.Namespace) -> int:
         if cert.status == "contradiction":
             for text in cert.contradictions:
                 print(f"cotm-bertini: certificate: {text}", file=sys.stderr)
-            return EXIT_CERTIFICATE
-        if cert.status not in ("proved", "rows proved"):  # rows proved: no completeness claim
-            return EXIT_INCOMPLETE
-    if res.status == "contradiction":
+    code = _exit_code(res.status, cert)
+    # The last line names the status and what its exit code means: run.json is not the only
+    # place that says a run is ok. --quiet keeps stdout to the folder, so it goes to stderr.
+    print(_status_line(code), file=sys.stderr if args.quiet else sys.stdout)
+    return code
+
+
+# A solve's status (run.json `status`) by its exit code, and what that code means (docs/cli.md).
+SOLVE_STATUS = {
+    EXIT_OK: ("ok", "every completeness check passed"),
+    EXIT_INCOMPLETE: (
+        "incomplete",
+        "a completeness check failed, equilibria may be missing (the warnings above, run.json)",
+    ),
+    EXIT_CERTIFICATE: (
+        "contradiction",
+        "a proof and an independent check disagree (the solver's Morse count, or the "
+        "certificate): a bug, see the warnings above",
+    ),
+}
+
+
+def _exit_code(status: str, cert) -> int:
+    """A solve's exit code: its status (a contradiction 4), overridden by a certificate that
+    contradicts the solver (4) or proves less than the rows and completeness (5)."""
+    if status == "contradiction" or (cert is not None and cert.status == "contradiction"):
         return EXIT_CERTIFICATE
-    return EXIT_OK if res.status == "ok" else EXIT_INCOMPLETE
+    if cert is not None and cert.status not in ("proved", "rows proved"):  # rows proved: no
+        return EXIT_INCOMPLETE  # completeness claim, and none expected
+    return EXIT_OK if status == "ok" else EXIT_INCOMPLETE
+
+
+def _status_line(code: int) -> str:
+    """The last line of a solve: `status ok (exit 0): ...`."""
+    status, meaning = SOLVE_STATUS[code]
+    return f"status {status} (exit {code}): {meaning}"
 
 
 def _certify(res):

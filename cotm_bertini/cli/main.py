@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
+from pathlib import Path
 
 from .._version import __version__
 from ..errors import CotmError, ParameterError, SolverError
@@ -268,8 +270,18 @@ def _parser() -> argparse.ArgumentParser:
     return ap
 
 
+def _warning_line(message, category, filename: str, lineno: int, line=None) -> str:
+    """A library warning as one console line, its source in brackets (not Python's two lines
+    with the source line quoted)."""
+    where = f"{category.__name__}, {Path(filename).name}:{lineno}"
+    return f"cotm-bertini: warning: {message} ({where})\n"
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the console script."""
+    # Warnings are fixed where they arise (model/intervals.py); one that is not yet reaches the
+    # console as one line, like the package's own.
+    warnings.formatwarning = _warning_line
     args = _parser().parse_args(argv)
     try:
         return args.run(args)

@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import difflib
+import re
+import sys
 from pathlib import Path
 
 from ..errors import ParameterError
@@ -28,10 +31,48 @@ EXIT_INCOMPLETE = 5
 
 
 class Parser(argparse.ArgumentParser):
-    """argparse with one-line errors and exit code 2."""
+    """argparse with one-line errors and exit code 2; an unknown option or command is named,
+    with the nearest known one."""
+
+    def parse_known_args(self, args=None, namespace=None):
+        """argparse's, after each --option of a command is checked against its known ones."""
+        if args is None and self._subparsers is not None:
+            args = sys.argv[1:]
+        if args is not None:  # the command's own options, or those before the command
+            unknown_option(self, list(args), self._subparsers is not None)
+        return super().parse_known_args(args, namespace)
 
     def error(self, message: str) -> None:
+        command = re.match(r"argument COMMAND: invalid choice: '([^']*)'", message)
+        if command and self._subparsers is not None:
+            known = list(self._subparsers._group_actions[0].choices)
+            hint = _nearest(command[1], known) or f" (commands: {', '.join(known)})"
+            message = f"unknown command {command[1]!r}{hint}"
         self.exit(EXIT_USAGE, f"cotm-bertini: error: {message}\n")
+
+
+def _nearest(word: str, known: list[str]) -> str:
+    """' (did you mean X?)' for the closest known word, if one is close."""
+    close = difflib.get_close_matches(word, known, n=1, cutoff=0.6)
+    return f" (did you mean {close[0]}?)" if close else ""
+
+
+def unknown_option(parser: argparse.ArgumentParser, args: list[str], top: bool = False) -> None:
+    """Refuse a --option the command does not know (argparse would take its value for the
+    case, or say only "unrecognized arguments"), naming the nearest known one. An unambiguous
+    prefix of a known option is argparse's to accept. `top`: the program's own options, those
+    before the command."""
+    known = [s for s in parser._option_string_actions if s.startswith("--")]
+    for arg in args:
+        if arg == "--" or (top and not arg.startswith("-")):  # the rest: values, or a command's
+            return
+        if not arg.startswith("--"):
+            continue
+        name = arg.split("=", 1)[0]
+        if not any(k.startswith(name) for k in known):
+            where = (" (a command's options go after it: `cotm-bertini COMMAND --help`)" if top
+                     else f" (`{parser.prog} --help` lists them)")  # fmt: skip
+            parser.error(f"unknown option {name}{_nearest(name, known) or where}")
 
 
 # Without a case the parameters are Table 1 as printed (L01 = L02 = 0), as for cb.Params(): one

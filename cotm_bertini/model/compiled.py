@@ -44,27 +44,27 @@ def _write(path: Path, text: str) -> None:
 @cache
 def parametric_system(zfl: tuple[bool, bool]) -> ParametricSystem:
     """The structure's equations as numbers (from the disk cache, or derived with sympy)."""
-    from .equations import derive_parametric
-
-    return _cached_system("system", zfl, derive_parametric)
+    return _cached_system("system", zfl, "derive_parametric")
 
 
 @cache
 def tan_half_parametric(zfl: tuple[bool, bool]) -> ParametricSystem:
     """The paper's tan-half equations (F, tau, C1, C2 in x1, x2, d1, d2) as numbers."""
-    from .equations import derive_tan_half
-
-    return _cached_system("tanhalf", zfl, derive_tan_half)
+    return _cached_system("tanhalf", zfl, "derive_tan_half")
 
 
-def _cached_system(kind: str, zfl: tuple[bool, bool], derive) -> ParametricSystem:
+def _cached_system(kind: str, zfl: tuple[bool, bool], derive: str) -> ParametricSystem:
     path = cache_root() / "equations" / f"{kind}-{_source_hash()}-{_tag(zfl)}.json"
     if path.is_file():
         try:
             return ParametricSystem.from_json(json.loads(path.read_text()))
         except (ValueError, KeyError):
             pass  # damaged: derive again
-    ps = derive(zfl)
+    # equations imports sympy (~0.3 s): only a cache miss pays for it, by name so a hit never
+    # reaches the module.
+    from . import equations
+
+    ps = getattr(equations, derive)(zfl)
     _write(path, json.dumps(ps.to_json()))
     return ps
 

@@ -73,7 +73,10 @@ class Interval:
 
     @property
     def mid(self) -> np.ndarray:
-        return 0.5 * self.lo + 0.5 * self.hi
+        """The midpoints; NaN for [-inf, inf], which callers read as not finite (a Krawczyk
+        step with an unbounded Hessian entry is no step): no RuntimeWarning on the console."""
+        with np.errstate(invalid="ignore"):
+            return 0.5 * self.lo + 0.5 * self.hi
 
     @property
     def width(self) -> np.ndarray:
@@ -192,8 +195,8 @@ class Interval:
             return out if n > 0 else out.reciprocal()
         # A real power is defined for x >= 0 only (here: squared lengths).
         lo, hi = np.maximum(self.lo, 0.0), np.maximum(self.hi, 0.0)
-        a, b = (lo**n, hi**n) if n > 0 else (hi**n, lo**n)
-        with np.errstate(invalid="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore"):  # 0 ** -r: inf, unbounded
+            a, b = (lo**n, hi**n) if n > 0 else (hi**n, lo**n)
             return Interval(*_clean(a * (1 - _PAD_POW), b * (1 + _PAD_POW) + 1e-300))
 
     # --- functions ----------------------------------------------------------------------------

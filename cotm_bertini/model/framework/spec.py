@@ -8,6 +8,7 @@ the slots only, so any parameter (and any expression of parameters) can be swept
 
 from __future__ import annotations
 
+import difflib
 import hashlib
 import math
 import re
@@ -25,6 +26,8 @@ _TOP_KEYS = {"name", "dim", "nodes", "parameters", "ground", "bodies", "pins", "
              "cables", "bars", "loads"}  # fmt: skip
 _LINK_KEYS = {"spring": {"name", "a", "b", "k", "L0"}, "cable": {"name", "a", "b", "k", "L0"},
               "bar": {"name", "a", "b", "length"}}  # fmt: skip
+_PIN_KEYS = {"a", "b"}
+_LOAD_KEYS = {"name", "point", "force"}
 
 
 @dataclass(frozen=True)
@@ -198,6 +201,37 @@ def _name(where: str, value: object) -> str:
     return value
 
 
+def check_keys(where: str, table: dict, known: set[str]) -> None:
+    """Refuse a key the table does not know, in one line naming the table and the nearest
+    known key (a misspelt key would otherwise surface as a missing one, or not at all)."""
+    for key in table:
+        if key in known:
+            continue
+        close = nearest_key(str(key), known)
+        hint = f"did you mean {close!r}?" if close else f"known: {', '.join(sorted(known))}"
+        raise ParameterError(f"{where}: unknown key {key!r} ({hint})")
+
+
+def nearest_key(key: str, known: set[str]) -> str | None:
+    """The known key `key` was probably meant to be: the same but for case, one that starts
+    the other (dimension: dim), else the closest by difflib; None if none is close."""
+    lower = key.lower()
+    for test in (lambda k: k.lower() == lower, lambda k: lower.startswith(k.lower())
+                 or k.lower().startswith(lower)):  # fmt: skip
+        found = sorted(k for k in known if test(k))
+        if found:
+            return found[0]
+    # Keys are short (a, b, k, L0): half the letters in common is close (LO for L0).
+    close = difflib.get_close_matches(key, sorted(known), n=1, cutoff=0.5)
+    return close[0] if close else None
+
+
+def _element(section: str, k: int, entry: dict) -> str:
+    """An entry of [[section]] as a message names it: springs[2], or springs[2] (top)."""
+    name = entry.get("name")
+    return f"{section}[{k}]" + (f" ({name})" if isinstance(name, str) else "")
+
+
 def _table(where: str, value: object) -> dict:
     if not isinstance(value, dict):
         raise ParameterError(f"{where}: expected a table, got {type(value).__name__}")
@@ -226,9 +260,7 @@ def _expr(where: str, value: object, params: set[str]) -> Expr:
 
 def from_dict(data: dict, source: str = "") -> Framework:
     """A validated Framework from the parsed TOML tables."""
-    extra = sorted(set(data) - _TOP_KEYS)
-    if extra:
-        raise ParameterError(f"{extra[0]}: unknown section (known: {' '.join(sorted(_TOP_KEYS))})")
+    check_keys("the framework file's top level", data, _TOP_KEYS)
     dim = data.get("dim", 2)
     if dim not in (2, 3) or isinstance(dim, bool):
         raise ParameterError(f"dim = {dim!r}: expected 2 (planar) or 3 (spatial)")
@@ -294,8 +326,8 @@ def _entries(section: str, value: object) -> list[dict]:
 def _pins(value: object) -> tuple[tuple[str, str], ...]:
     out = []
     for k, pin in enumerate(_entries("pins", value), start=1):
-        extra = sorted(set(pin) - {"a", "b"})
-        if extra or "a" not in pin or "b" not in pin:
+        check_keys(f"pins[{k}]", pin, _PIN_KEYS)
+        if "a" not in pin or "b" not in pin:
             raise ParameterError(f"pins[{k}]: expects exactly the keys a and b")
         out.append((str(pin["a"]), str(pin["b"])))
     return tuple(out)
@@ -306,9 +338,7 @@ def _links(data: dict, params: set[str]) -> tuple[Link, ...]:
     for kind, section in (("spring", "springs"), ("cable", "cables"), ("bar", "bars")):
         for k, entry in enumerate(_entries(section, data.get(section, [])), start=1):
             where = f"{section}[{k}]"
-            extra = sorted(set(entry) - _LINK_KEYS[kind])
-            if extra:
-                raise ParameterError(f"{where}.{extra[0]}: unknown key for a {kind}")
+            check_keys(_element(section, k, entry), entry, _LINK_KEYS[kind])
             need = ("a", "b", "length") if kind == "bar" else ("a", "b", "k", "L0")
             for key in need:
                 if key not in entry:
@@ -323,6 +353,7 @@ def _links(data: dict, params: set[str]) -> tuple[Link, ...]:
 def _loads(value: object, dim: int, params: set[str]) -> tuple[Load, ...]:
     out = []
     for k, entry in enumerate(_entries("loads", value), start=1):
+        check_keys(_element("loads", k, entry), entry, _LOAD_KEYS)
         name = _name(f"loads[{k}].name", entry.get("name", f"load{k}"))
         if "point" not in entry or "force" not in entry:
             raise ParameterError(f"loads.{name}: needs point and force")

@@ -71,7 +71,7 @@ stress: $(STAMP) phcpack
 	  tests/test_monodromy.py tests/test_certify_agreement.py \
 	  tests/test_real_route.py tests/test_total_degree_route.py tests/test_continuum.py \
 	  tests/test_spatial_real.py tests/test_box_shares.py tests/test_paper_real.py \
-	  tests/test_chart_map.py
+	  tests/test_chart_map.py tests/test_real_route_property.py
 
 bench: $(STAMP) phcpack
 	$(BIN)/python bench/run_all.py

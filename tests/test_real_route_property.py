@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 import random_mechanisms as rm
 import tensegrity_physics as tp
+from conftest import ROOT
 
 import cotm_bertini as cb
 
@@ -68,3 +69,36 @@ def test_random_hanging_nodes_proved_hold_every_newton_point(seed, nodes, tmp_pa
         assert math.isclose(float(row["energy"]), p["energy"], rel_tol=1e-9, abs_tol=1e-9)
         if p["index"] >= 0:
             assert int(row["index"]) == p["index"]
+
+
+def test_prism_saddle_is_proved_with_its_global_minimum():
+    """A grounded three-strut prism with constant stiffnesses and loads on every node: the
+    search once excluded its global minimum (the slope matrix had every cable taut, as no
+    parameter could switch a constant stiffness off). The minimum and the index-2 saddle that
+    an independent Newton search and 200 random descents find (V = -0.1979369857 and
+    3.8700237544) are rows, with the other 6: 8 equilibria, 1 stable, proved."""
+    fw = cb.Framework.from_toml(ROOT / "tests" / "fixtures" / "prism_saddle.toml")
+    res = cb.solve(fw, cache=False)
+    assert res.status == "ok", res.warnings
+    rows = res.physical
+    assert len(rows) == 8 and int(res.counts["stable"]) == 1
+    (low,) = rows.index[rows["stable"].astype(bool)]
+    assert math.isclose(float(rows.loc[low, "energy"]), -0.1979369857, abs_tol=1e-9)
+    A = rows.loc[low, ["A.x", "A.y", "A.z"]].to_numpy(float)
+    assert np.abs(A - [-0.245671, -0.081331, -0.286615]).max() < 1e-6
+    saddle = rows[np.isclose(rows["energy"].astype(float), 3.8700237544, atol=1e-9)]
+    assert len(saddle) == 1 and int(saddle["index"].iloc[0]) == 2
+
+
+def test_a_node_free_to_float_is_reported_as_a_region_and_the_search_finishes():
+    """Node B hangs with one cable and no load: where that cable is slack V is flat along B,
+    a region of equilibria. The search finishes in seconds, names the free angles (B's) and
+    the other node's equilibrium there, and says the status is incomplete, not ok."""
+    fw = cb.Framework.from_toml(ROOT / "tests" / "fixtures" / "floppy_node.toml")
+    res = cb.solve(fw, cache=False)
+    search = res.record["details"]["real_search"]
+    assert res.status == "incomplete"
+    regions = search["free_regions"]
+    assert regions and all(r["free_angles"] == [2, 3] for r in regions)
+    assert any("V is flat over regions" in w for w in res.warnings)
+    assert search["seconds"] < 60

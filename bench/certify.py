@@ -5,7 +5,7 @@ certificates (issue 19) against their solves. Prints; asserts nothing.
 
 Each solve is the homotopy engine's, generic set warm, no cache (what `certify case3` runs the
 first time); each proof is cold (the parallel curve's cover is not reused between them).
-Usage: .venv/bin/python bench/certify.py [--random 20] [--torus] [--frameworks]
+Usage: .venv/bin/python bench/certify.py [--random 20] [--torus] [--frameworks [--only NAME ...]]
 """
 
 from __future__ import annotations
@@ -57,8 +57,12 @@ def one(params, label: str, torus: bool) -> dict:
 
 
 FRAMEWORKS = {"zeeman": {"x": 0.1, "y": -0.25}, "zeeman_cables": {"x": 1.45, "y": 0.2},
-              "double_pendulum": {}, "cotm": {},
+              "double_pendulum": {}, "cotm": {}, "xmodule": {}, "chain3": {}, "chain4": {},
               "fourbar": {}}  # fmt: skip
+ROOT = Path(__file__).resolve().parent.parent
+# The examples, and the 4-link chain of issue 46 (a 4-torus: the certificate's hardest case).
+FILES = {name: ROOT / "examples" / f"{name}.toml" for name in FRAMEWORKS} | {
+    "chain4": ROOT / "tests" / "fixtures" / "chain4.toml"}  # fmt: skip
 
 
 def one_framework(name: str) -> dict:
@@ -67,8 +71,7 @@ def one_framework(name: str) -> dict:
     from cotm_bertini.analysis.certify.framework import certify_framework_table
     from cotm_bertini.point import solve_framework_point
 
-    root = Path(__file__).resolve().parent.parent
-    fw = cb.Framework.from_toml(root / "examples" / f"{name}.toml").replace(**FRAMEWORKS[name])
+    fw = cb.Framework.from_toml(FILES[name]).replace(**FRAMEWORKS[name])
     solve_framework_point(fw)  # warm: generic sets and generated code loaded
     start = time.perf_counter()
     solved = solve_framework_point(fw)
@@ -83,9 +86,9 @@ def one_framework(name: str) -> dict:
     }  # fmt: skip
 
 
-def frameworks() -> None:
+def frameworks(names: list[str]) -> None:
     """The examples' certificates against their solves."""
-    table = pd.DataFrame([one_framework(n) for n in FRAMEWORKS])
+    table = pd.DataFrame([one_framework(n) for n in names or FRAMEWORKS])
     formats = {k: ".3f" for k in ("solve_s", "certify_s", "rows_s", "complete_s")}
     show("Frameworks: certification against the solve (seconds, 2 cores)", table,
          {**formats, "ratio": ".2f"})  # fmt: skip
@@ -101,9 +104,11 @@ def main() -> None:
     ap.add_argument("--random", type=int, default=20, help="random geometries to certify")
     ap.add_argument("--torus", action="store_true", help="also time the 2-D branch and bound")
     ap.add_argument("--frameworks", action="store_true", help="only the example frameworks")
+    ap.add_argument("--only", nargs="*", default=[], choices=list(FRAMEWORKS),
+                    help="with --frameworks: these frameworks only")  # fmt: skip
     args = ap.parse_args()
     if args.frameworks:
-        frameworks()
+        frameworks(args.only)
         return
     rows = [one(Params.case(case), case, args.torus) for case in ("case1", "case2", "case3")]
     rows += [one(random_params(s), f"random {s}", args.torus) for s in range(1, args.random + 1)]

@@ -38,10 +38,6 @@ def product_range(x, y):
     return (a * c).union(a * d).union(b * c).union(b * d)
 
 
-def _times(x, y):
-    return x * y
-
-
 def square_range(x):
     """A ball holding x^2 over the ball x: the hull of its ends' squares, and of 0 if x holds
     it (x * x of (2 +- 1) is -1 .. 9; this is 1 .. 9)."""
@@ -77,7 +73,11 @@ class TorusV:
         springs = {x.name for x in fw.springs}
         self.links = [(x, slot[f"k_{x}"], None if x in zfl else slot[f"L0_{x}"], x in springs)
                       for x in full.active]  # fmt: skip
-        self.split, self.split_tight = self._compile()
+        self.code = self._compile()
+        self.kL0 = [None if L0 is None else k * L0 for _, k, L0, _ in self.links]
+        self.free = [
+            i for i, (_, _, L0, spring) in enumerate(self.links) if L0 is not None and spring
+        ]
         self.memo: dict = {}  # the last box's parts: the search asks for them twice
 
     def _system(self, taut: tuple) -> tuple:
@@ -97,58 +97,57 @@ class TorusV:
             X[s], X[c] = a.sin_cos()
         return code, X
 
-    def _compile(self) -> tuple[Callable, Callable]:
-        """first_order's entries -> (d^2 of each active link, r . dr/dangle_j of each, the
-        loads' gradient) as straight-line code: an entry that is a constant (the same number at
-        every pose) enters as that ball, and a product with the constant 0 not at all. Two
-        versions: with ball products, and with the products and squares as the hulls of their
-        ends' (`product_range`, `square_range`: tighter over a wide box, slower)."""
+    def _compile(self) -> dict[bool, tuple[Callable, Callable]]:
+        """first_order's entries f -> d^2 of each active link (`squares(f)`), and f and the
+        links' weights w -> grad V = the loads' gradient + sum_i w_i r_i . dr_i/dangle
+        (`gradient(f, w)`), as straight-line code: an entry that is a constant (the same number
+        at every pose) enters as that ball, and a product with the constant 0 not at all. Two
+        versions (key: tight): with ball products, and with the products and squares as the
+        hulls of their ends' (`product_range`, `square_range`: tighter over a wide box, slower)."""
         code, X = self.pose(tuple(self.cables), tuple(arb(0.1 + j, 0.5) for j in range(self.m)))
         first = code.first_order(X, self.P)
         names = {"ZERO": ZERO, "square": square_range, "product": product_range}
         for e, v in enumerate(first):
             if type(v) is not arb:
                 names[f"C{e}"] = arb(v)
-        out = []
-        for square, product in (("{0} * {0}", "{0} * {1}"), ("square({0})", "product({0}, {1})")):
-            source = self._source(first, square, product)
+        out = {}
+        for tight, square, product in ((False, "{0} * {0}", "{0} * ({1})"),
+                                       (True, "square({0})", "product({0}, {1})")):  # fmt: skip
             space = dict(names)
+            source = self._source(first, square, product)
             exec(compile(source, "<framework_torus parts>", "exec"), space)
-            out.append(space["parts"])
-        return out[0], out[1]
+            out[tight] = (space["squares"], space["gradient"])
+        return out
 
     def _source(self, first: list, square: str, product: str) -> str:
-        """The source of `parts(f)` (see _compile), squares and products written by the
-        format strings `square` ({0}) and `product` ({0}, {1})."""
+        """The source of `squares(f)` and `gradient(f, w)` (see _compile), squares and
+        products written by the format strings `square` ({0}) and `product` ({0}, {1})."""
         entry = [f"f[{e}]" if type(v) is arb else f"C{e}" for e, v in enumerate(first)]
         dim, m, per = self.dim, self.m, self.dim + self.dim * self.m
-        dds, dots = [], []
+        nonzero = [type(v) is arb or bool(v) for v in first]
+        dds, grad = [], [[e] for e in entry[len(self.links) * per :]]
         for i in range(len(self.links)):
             r = [entry[i * per + c] for c in range(dim)]
             dds.append(" + ".join(square.format(x) for x in r))
-            base = i * per + dim
-            row = []
             for j in range(m):
-                at = [base + c * m + j for c in range(dim)]
-                terms = [product.format(r[c], entry[e]) for c, e in enumerate(at)
-                         if type(first[e]) is arb or first[e]]  # fmt: skip
-                row.append(" + ".join(terms) or "ZERO")
-            dots.append(f"[{', '.join(row)}]")
-        loads = entry[len(self.links) * per :]
-        return (f"def parts(f):\n    return [{', '.join(dds)}], [{', '.join(dots)}], "
-                f"[{', '.join(loads)}]\n")  # fmt: skip
+                at = [i * per + dim + c * m + j for c in range(dim)]
+                terms = [product.format(r[c], entry[e]) for c, e in enumerate(at) if nonzero[e]]
+                if terms:
+                    grad[j].append(product.format(f"w[{i}]", " + ".join(terms)))
+        sums = ", ".join(" + ".join(g) for g in grad)
+        return (f"def squares(f):\n    return [{', '.join(dds)}]\n\n"
+                f"def gradient(f, w):\n    return [{sums}]\n")  # fmt: skip
 
-    def parts(self, balls) -> tuple:
-        """(per active link (name, k, L0 or None, is a spring, d^2, r . dr/dangle), the loads'
-        gradient) over the box."""
-        if self.memo.get("balls") is balls:  # the same tuple (kept alive here: its id is unique)
-            return self.memo["parts"]
-        code, X = self.pose(tuple(self.cables), balls)
-        tight = max(float(a.rad()) for a in balls) > TIGHT_RADIUS
-        dds, dots, loads = (self.split_tight if tight else self.split)(code.first_order(X, self.P))
-        out = [(*link, dd, a) for link, dd, a in zip(self.links, dds, dots, strict=True)]
-        self.memo = {"balls": balls, "parts": (out, loads), "tight": tight}
-        return self.memo["parts"]
+    def _box(self, balls) -> dict:
+        """What this box's enclosures share: first_order's entries over it, whether its
+        products are hulls, d^2 of each active link (kept until the next box)."""
+        if self.memo.get("balls") is not balls:  # the same tuple (kept alive here: unique id)
+            code, X = self.pose(tuple(self.cables), balls)
+            tight = max(float(a.rad()) for a in balls) > TIGHT_RADIUS
+            first = code.first_order(X, self.P)
+            self.memo = {"balls": balls, "first": first, "tight": tight,
+                         "dds": self.code[tight][0](first)}  # fmt: skip
+        return self.memo
 
     def state(self, name: str, L0, dd) -> str:
         """'taut', 'slack' or 'either' for a link over the box (a spring is always taut)."""
@@ -156,26 +155,31 @@ class TorusV:
             return "taut"
         return "slack" if dd < L0 * L0 else "either"
 
-    def enclose(self, balls, hessian: bool = True) -> tuple:
-        """(grad V over the box, its Hessian's enclosure or None)."""
-        links, loads = self.parts(balls)
-        if "grad" in self.memo:  # this box's gradient, asked for again with the Hessian
-            grad, states = self.memo["grad"]
-            return grad, self.hessian(balls, states) if hessian else None
-        grad, states = list(loads), {}
-        times = product_range if self.memo["tight"] else _times
-        for name, k, L0, _, dd, a in links:
+    def weights(self, dds: list) -> tuple[list, dict]:
+        """w of each active link over the box (0 for a slack cable), and each cable's state."""
+        ws, states = [], {}
+        for (name, k, L0, _), kL0, dd in zip(self.links, self.kL0, dds, strict=True):
+            if L0 is None or name not in self.cables:  # k, or k - k L0 / d = k (1 - L0 / d)
+                ws.append(k if L0 is None else k - kL0 / dd.sqrt())
+                continue
             states[name] = self.state(name, L0, dd)
             if states[name] == "slack":
+                ws.append(ZERO)
                 continue
-            w = k if L0 is None else k * (1 - L0 / dd.sqrt())
+            w = k * (1 - L0 / dd.sqrt())
             if states[name] == "either":  # k max(1 - L0/d, 0), which lies in [0, k]
                 w = arb(0).union(w) if w.is_finite() else k * arb(0.5, 0.5)
-            grad = [g + times(w, aj) for g, aj in zip(grad, a, strict=True)]
-        self.memo["grad"] = (grad, states)
-        if not hessian:
-            return grad, None
-        return grad, self.hessian(balls, states)
+            ws.append(w)
+        return ws, states
+
+    def enclose(self, balls, hessian: bool = True) -> tuple:
+        """(grad V over the box, its Hessian's enclosure or None)."""
+        memo = self._box(balls)
+        if "grad" not in memo:  # else this box's gradient, asked for again with the Hessian
+            w, states = self.weights(memo["dds"])
+            memo["grad"] = (self.code[memo["tight"]][1](memo["first"], w), states)
+        grad, states = memo["grad"]
+        return grad, self.hessian(balls, states) if hessian else None
 
     def hessian(self, balls, states: dict) -> list:
         """The hull of the Hessians of every taut set the box allows."""
@@ -192,5 +196,5 @@ class TorusV:
 
     def lengths(self, balls) -> list:
         """d^2 of every spring with a free length (V has a cone point where one is 0)."""
-        return [dd for _, _, L0, spring, dd, _ in self.parts(balls)[0]
-                if L0 is not None and spring]  # fmt: skip
+        dds = self._box(balls)["dds"]
+        return [dds[i] for i in self.free]

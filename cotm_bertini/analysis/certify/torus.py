@@ -214,10 +214,13 @@ def _short(lengths: list, limit) -> str:
     return verdict
 
 
-def _split(q: tuple) -> list[tuple]:
+def _split(q: tuple, balls: tuple | None = None) -> list:
     """A box halved along its MAX_CUTS widest sides (those at least half as wide as its widest;
     in one or two angles: every side). In four angles a box cut along every side makes 16 boxes
-    where the first halvings would often have excluded half of them."""
+    where the first halvings would often have excluded half of them. With `balls` (box(*q)):
+    each half as (bounds, its balls), the balls of the sides not cut kept."""
+    from flint import arb
+
     n = len(q) // 2
     widths = [q[2 * j + 1] - q[2 * j] for j in range(n)]
     order = sorted(range(n), key=lambda j: -widths[j])[:MAX_CUTS]
@@ -225,9 +228,15 @@ def _split(q: tuple) -> list[tuple]:
     halves = []
     for j in range(n):
         lo, hi = q[2 * j], q[2 * j + 1]
-        mid = (lo + hi) / 2
-        halves.append(((lo, mid), (mid, hi)) if j in cut else ((lo, hi),))
-    return [tuple(v for pair in choice for v in pair) for choice in itertools.product(*halves)]
+        if j in cut:
+            mid = (lo + hi) / 2
+            halves.append((((lo, mid), _interval(arb, lo, mid)),
+                           ((mid, hi), _interval(arb, mid, hi))))  # fmt: skip
+        else:
+            halves.append((((lo, hi), balls[j] if balls else None),))
+    out = [(tuple(v for (pair, _) in choice for v in pair), tuple(b for _, b in choice))
+           for choice in itertools.product(*halves)]  # fmt: skip
+    return out if balls else [bounds for bounds, _ in out]
 
 
 def branch_and_bound(
@@ -265,18 +274,18 @@ def torus_search(
     start = start or (16 if land.n <= 2 else 8)
     edges = np.linspace(0.0, TWO_PI, start + 1)
     cells = list(zip(edges[:-1], edges[1:], strict=True))
-    stack = [tuple(v for c in choice for v in c) for choice in itertools.product(cells,
-             repeat=land.n)]  # fmt: skip
+    stack = [(q, box(*q)) for q in (tuple(v for c in choice for v in c)
+             for choice in itertools.product(cells, repeat=land.n))]  # fmt: skip
     # How far: the share of the torus in boxes decided (neither on the stack nor split).
     report, pending = Progress("certificate search", 1.0, "of the poses decided"), 1.0
     low_square = math.inf  # at most the square of every spring's length over every leaf
     while stack:
         if not proof.boxes % 256:  # a line costs more than a box: not every box
             report.set(1.0 - pending, note=f"{proof.boxes} boxes")
-        q = stack.pop()
-        pending -= _share(q)
+        q, balls = stack.pop()
+        share = _share(q)
+        pending -= share
         proof.boxes += 1
-        balls = box(*q)
         width = max(q[2 * j + 1] - q[2 * j] for j in range(land.n))
         lengths = land.lengths(balls)
         near = _short(lengths, limit if width > min_width else wide)
@@ -285,13 +294,13 @@ def torus_search(
             shortest = min(float(dd.upper()) for dd in lengths)
             proof.longest_excluded = max(proof.longest_excluded, math.sqrt(shortest))
             continue
-        outcome = _visit(land, q, balls, not near, (bounds, centres, min_width), proof)
+        outcome = _visit(land, (q, balls, width), not near, (bounds, centres, min_width), proof)
         if outcome != "done":
             floor = ROOT_MIN_WIDTH if outcome == "root" else _floor(lengths, min_width,
                                                                     land.length_unit)  # fmt: skip
             if width > floor:
-                stack.extend(_split(q))
-                pending += _share(q)
+                stack.extend(_split(q, balls))
+                pending += share
                 continue
             proof.undecided.append(q)
         # A leaf of the search (decided or undecided): its lengths bound them from below.
@@ -327,19 +336,19 @@ def length_floor(squares: list) -> float:
     return math.nextafter(out, 0.0) if 0 < out < math.inf else out
 
 
-def _visit(land: Landscape, q: tuple, balls: tuple, smooth: bool, known: tuple,
-           proof: TorusProof) -> str:  # fmt: skip
+def _visit(land: Landscape, where: tuple, smooth: bool, known: tuple, proof: TorusProof) -> str:
     """'done' (the box holds no critical point, or one matched to a known equilibrium, or one
     recorded as missing), 'split', or 'root' (split on down to ROOT_MIN_WIDTH: a known
-    equilibrium is in or near the box; undecided below it). `smooth`: every spring with a free
-    length is longer than the limit over the box; `known`: (enclosure bounds, centres,
-    min_width)."""
+    equilibrium is in or near the box; undecided below it). `where`: (the box's bounds, its
+    balls, its widest side); `smooth`: every spring with a free length is longer than the limit
+    over the box; `known`: (enclosure bounds, centres, min_width)."""
     if not smooth:
         return "split"
+    q, balls, width = where
     grad, _ = land.enclose(balls, hessian=False)
     if not all(g.contains(0) for g in grad):
         return "done"
-    if max(q[2 * j + 1] - q[2 * j] for j in range(land.n)) > KRAWCZYK_WIDTH:
+    if width > KRAWCZYK_WIDTH:
         return "split"
     verdict, _k = krawczyk_box(land, q, balls)
     if verdict == "none":

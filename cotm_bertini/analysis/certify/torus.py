@@ -280,7 +280,7 @@ def torus_search(
     report, pending = Progress("certificate search", 1.0, "of the poses decided"), 1.0
     low_square = math.inf  # at most the square of every spring's length over every leaf
     while stack:
-        if not proof.boxes % 256:  # a line costs more than a box: not every box
+        if not proof.boxes % 32:  # a line costs more than a box: not every box
             report.set(1.0 - pending, note=f"{proof.boxes} boxes")
         q, balls = stack.pop()
         share = _share(q)

@@ -4,9 +4,10 @@ zero-length points.
 
 V is given by a `Landscape`: enclosures of its gradient and Hessian over a box of angles, and of
 the squared lengths of the springs with free lengths (the paper's mechanism: `paper_landscape`;
-a framework whose poses form a torus: analysis.certify_framework). Each box of angles is either
+a framework whose poses form a torus: certify.framework_torus). Each box of angles is either
 excluded (an interval enclosure of grad V misses 0), or shown by the Krawczyk operator to hold
-exactly one critical point (K(Q) in the interior of Q) or none (K(Q) misses Q), or split. V is
+exactly one critical point (K(Q) in the interior of Q) or none (K(Q) misses Q; the test is tried
+on boxes no wider than KRAWCZYK_WIDTH only), or split along its two widest sides (`_split`). V is
 not smooth where a spring with L0 > 0 has zero length: boxes where such a spring is certainly
 shorter than `short` are set aside, and so are boxes where it may be, once split down to
 `min_width`; the proof bounds the spring length over every box set aside, so the statement is:

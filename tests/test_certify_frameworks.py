@@ -217,3 +217,33 @@ def test_a_cached_solve_is_certified_alike(zeeman, certified):
     assert cert.status == "proved", cert.statement
     assert (cert.certified == certified["zeeman"].certified).all()
     assert cert.kinds == certified["zeeman"].kinds
+
+
+@pytest.fixture(scope="module")
+def chain4():
+    # Issue 46's case: a chain of four links (a 4-torus of poses, 34 equilibria), on the real
+    # route; its certificate once took 40 times its solve.
+    return cb.solve(cb.Framework.from_toml(ROOT / "tests" / "fixtures" / "chain4.toml"))
+
+
+def test_a_missing_equilibrium_is_found_on_a_4_torus(chain4):
+    # The search in four angles halves two sides a box (not all four) and starts from a coarser
+    # grid: a critical point the table lacks must still be found, and every other one proved.
+    table = chain4.table.reset_index(drop=True)
+    phys = np.flatnonzero(table["physical"].to_numpy(dtype=bool))
+    dropped = int(table["solution_id"][phys[len(phys) // 2]])
+    cert = certify_framework_table(chain4.params, table.drop(index=phys[len(phys) // 2])
+                                   .reset_index(drop=True))  # fmt: skip
+    assert cert.status == "contradiction", cert.statement
+    missing = [c for c in cert.contradictions if "is not in the table" in c]
+    assert len(missing) == 1, cert.contradictions
+    assert dropped not in cert.kinds and cert.proved_equilibria == len(phys) - 1
+
+
+@pytest.mark.slow
+def test_a_4_torus_is_proved_with_the_solves_count(chain4):
+    cert = cb.certify(chain4)
+    assert cert.status == "proved", cert.statement
+    assert cert.proved_equilibria == len(chain4.physical) == 34
+    assert cert.kinds == _table_kinds(chain4.physical)
+    assert not cert.undecided_boxes and cert.excluded_boxes == 0

@@ -8,7 +8,7 @@
 2. Each proved physical row: its consistency (every length variable > 0, a taut cable longer
    than its free length, a slack one shorter) and its kind (the inertia of the reduced Hessian,
    `certify/inertia`) over the proved box.
-3. Where the poses form a circle or a torus (with cables too: V piecewise, `_TorusV`):
+3. Where the poses form a circle or a torus (with cables too: V piecewise, `framework_torus`):
    completeness by the branch and bound of `certify/torus` on V in the body angles, enclosed by
    the derivation's own generated code evaluated on balls (model.framework.ballcode).
 Elsewhere the certificate says what is proved (the rows) and that completeness is not.
@@ -16,7 +16,6 @@ Elsewhere the certificate says what is proved (the rows) and that completeness i
 
 from __future__ import annotations
 
-import itertools
 import math
 import time
 from dataclasses import dataclass, field
@@ -30,6 +29,7 @@ from ...model.framework.spec import Framework
 from ...model.framework.structure import layout
 from ...model.framework.units import normalized_slots, slot_kind, units
 from ..framework_classify import quaternion_columns, sign_free
+from .framework_torus import torus_landscape
 from .inertia import reduced_kind
 from .mechanism import (
     ROOT_FAILED,
@@ -265,96 +265,6 @@ def consistency(fw: Framework, fs: FrameworkSystem, X: list, P: list) -> tuple[s
         open_links += [f"{x.kind} {x.name}"] if verdicts[-1] == "unknown" else []
     verdict = "no" if "no" in verdicts else "unknown" if "unknown" in verdicts else "yes"
     return verdict, open_links
-
-
-def torus_landscape(fw: Framework, P: list) -> Landscape:
-    """V of a framework whose poses form a torus (only body rotations), in the body angles
-    (`_TorusV`)."""
-    v = _TorusV(fw, P)
-    return Landscape(v.m, v.enclose, v.lengths, 1.0)
-
-
-class _TorusV:
-    """grad V = sum w r . dr/dangle plus the loads' gradient, w = k (1 - L0 / |r|) for a spring
-    (k at zero free length), k max(1 - L0 / |r|, 0) for a cable, from the generated `first_order`
-    of the system with every cable taut; the Hessian from the generated `hessian` of each taut
-    set a box allows (a cable taut, slack, or either where its length may be L0: then the hull
-    of both, a valid slope matrix since grad V is Lipschitz and piecewise smooth)."""
-
-    def __init__(self, fw: Framework, P: list):
-        self.fw, self.P, self.dim = fw, P, fw.dim
-        self.cables = [c.name for c in fw.cables]
-        self.full = framework_system(fw, tuple(self.cables))
-        self.m = self.full.local_size
-        slot = dict(zip(fw.slots(), P, strict=True))
-        zfl = set(fw.zero_free_length())
-        self.links = [(x, slot[f"k_{x}"], None if x in zfl else slot[f"L0_{x}"])
-                      for x in self.full.active]  # fmt: skip
-        self.memo: dict = {}  # the last box's parts: the search asks for them twice
-
-    def pose(self, fs: FrameworkSystem, balls) -> list:
-        index = {v: j for j, v in enumerate(fs.ps.variables)}
-        X = [arb(0)] * len(fs.ps.variables)
-        for b, a in zip(layout(self.fw).rotations, balls, strict=True):
-            X[index[f"s_{b}"]], X[index[f"c_{b}"]] = a.sin_cos()
-        return X
-
-    def parts(self, balls) -> tuple:
-        """Per active link (name, k, L0 or None, d^2, r . dr/dangle), and the loads' gradient."""
-        if self.memo.get("balls") is balls:  # the same tuple (kept alive here: its id is unique)
-            return self.memo["parts"]
-        dim, m = self.dim, self.m
-        first = [_ball(v) for v in ball_module(self.full).first_order(self.pose(self.full, balls),
-                                                                      self.P)]  # fmt: skip
-        per, out = dim + dim * m, []
-        for i, (name, k, L0) in enumerate(self.links):
-            r, dr = first[i * per : i * per + dim], first[i * per + dim : (i + 1) * per]
-            dd = sum((c * c for c in r[1:]), r[0] * r[0])
-            a = [sum((r[c] * dr[c * m + j] for c in range(1, dim)), r[0] * dr[j])
-                 for j in range(m)]  # fmt: skip
-            out.append((name, k, L0, dd, a))
-        self.memo.update(balls=balls, parts=(out, first[len(self.links) * per :]))
-        return self.memo["parts"]
-
-    def state(self, name: str, L0, dd) -> str:
-        """'taut', 'slack' or 'either' for a link over the box (a spring is always taut)."""
-        if name not in self.cables or L0 is None or dd > L0 * L0:
-            return "taut"
-        return "slack" if dd < L0 * L0 else "either"
-
-    def enclose(self, balls, hessian: bool = True):
-        springs, loads = self.parts(balls)
-        grad, states = [_ball(v) for v in loads], {}
-        for name, k, L0, dd, a in springs:
-            states[name] = self.state(name, L0, dd)
-            if states[name] == "slack":
-                continue
-            w = k if L0 is None else k * (1 - L0 / dd.sqrt())
-            if states[name] == "either":  # k max(1 - L0/d, 0), which lies in [0, k]
-                w = arb(0).union(w) if w.is_finite() else k * arb(0.5, 0.5)
-            grad = [g + w * aj for g, aj in zip(grad, a, strict=True)]
-        if not hessian:
-            return grad, None
-        return grad, self.hessian(balls, states)
-
-    def hessian(self, balls, states: dict) -> list:
-        """The hull of the Hessians of every taut set the box allows."""
-        options = [(True,) if states.get(c, "taut") == "taut" else (False,)
-                   if states[c] == "slack" else (True, False) for c in self.cables]  # fmt: skip
-        hull = None
-        for combo in itertools.product(*options):
-            taut = tuple(c for c, on in zip(self.cables, combo, strict=True) if on)
-            fs = framework_system(self.fw, taut)
-            h = [_ball(v) for v in ball_module(fs).hessian(self.pose(fs, balls), self.P)]
-            hull = h if hull is None else [x.union(y) for x, y in zip(hull, h, strict=True)]
-        m = self.m
-        return [hull[i * m : (i + 1) * m] for i in range(m)]
-
-    def lengths(self, balls) -> list:
-        """d^2 of every spring with a free length (V has a cone point where one is 0)."""
-        springs = {x.name for x in self.fw.springs}
-        return [dd for name, _, L0, dd, _ in self.parts(balls)[0]
-                if L0 is not None and name in springs]  # fmt: skip
 
 
 def _completeness_scope(fw: Framework) -> str:

@@ -4,9 +4,10 @@ zero-length points.
 
 V is given by a `Landscape`: enclosures of its gradient and Hessian over a box of angles, and of
 the squared lengths of the springs with free lengths (the paper's mechanism: `paper_landscape`;
-a framework whose poses form a torus: analysis.certify_framework). Each box of angles is either
+a framework whose poses form a torus: certify.framework_torus). Each box of angles is either
 excluded (an interval enclosure of grad V misses 0), or shown by the Krawczyk operator to hold
-exactly one critical point (K(Q) in the interior of Q) or none (K(Q) misses Q), or split. V is
+exactly one critical point (K(Q) in the interior of Q) or none (K(Q) misses Q; the test is tried
+on boxes no wider than KRAWCZYK_WIDTH only), or split along its two widest sides (`_split`). V is
 not smooth where a spring with L0 > 0 has zero length: boxes where such a spring is certainly
 shorter than `short` are set aside, and so are boxes where it may be, once split down to
 `min_width`; the proof bounds the spring length over every box set aside, so the statement is:
@@ -31,6 +32,8 @@ from ..energy_terms import gradient_hessian
 
 TWO_PI = 2 * math.pi
 ROOT_MIN_WIDTH = 1e-10  # boxes holding a known equilibrium's enclosure are split down to this
+KRAWCZYK_WIDTH = 0.1  # radians: wider boxes are split, not tested (the test rarely decides them)
+MAX_CUTS = 2  # sides halved at a split (see _split)
 
 
 @dataclass(frozen=True)
@@ -57,7 +60,17 @@ def box(*bounds: float) -> tuple:
     """Balls holding [lo1, hi1] x [lo2, hi2] x ... exactly."""
     from flint import arb
 
-    return tuple(arb(lo).union(arb(hi)) for lo, hi in zip(bounds[::2], bounds[1::2], strict=True))
+    return tuple(_interval(arb, lo, hi) for lo, hi in zip(bounds[::2], bounds[1::2], strict=True))
+
+
+def _interval(arb, lo: float, hi: float):
+    """A ball holding [lo, hi]: its float midpoint and a radius at least the distance to either
+    end (a float difference is within half an ulp of the exact one: the next float up holds
+    it)."""
+    mid = 0.5 * (lo + hi)
+    if lo == hi or not (math.isfinite(mid) and lo <= mid <= hi):
+        return arb(lo).union(arb(hi))
+    return arb(mid, math.nextafter(max(hi - mid, mid - lo), math.inf))
 
 
 def enclosures(pa, g1, g2, hessian: bool = True):
@@ -99,32 +112,45 @@ def krawczyk_2d(params: Params, pa, q: tuple[float, float, float, float]) -> tup
     return krawczyk_box(paper_landscape(params, pa), q)
 
 
-def krawczyk_box(land: Landscape, q: tuple) -> tuple[str, tuple]:
+def krawczyk_box(land: Landscape, q: tuple, balls: tuple | None = None) -> tuple[str, tuple]:
     """('one', K) (exactly one critical point in the box, and it lies in K), ('none', K), or
-    ('unknown', K); K is the Krawczyk image of the box (arb balls)."""
+    ('unknown', K); K is the Krawczyk image of the box (arb balls); `balls`: box(*q), if made."""
     from flint import arb, arb_mat
 
     n = land.n
     m = [(q[2 * j] + q[2 * j + 1]) / 2 for j in range(n)]
-    balls = box(*q)
-    grad_m, _ = land.enclose(tuple(arb(v) for v in m), hessian=False)
-    _, hq = land.enclose(balls)
-    # The preconditioner: the inverse of the Hessian's midpoint (any matrix is sound here).
-    h_mid = np.array([[float(h.mid()) for h in row] for row in hq])
-    if not np.isfinite(h_mid).all() or abs(np.linalg.det(h_mid)) < 1e-300:
+    balls = balls or box(*q)
+    _, hq = land.enclose(balls)  # first: the search has just enclosed grad V over this box
+    if not all(h.is_finite() for row in hq for h in row):
         return "unknown", ()
-    y = np.linalg.inv(h_mid)
-    ym = arb_mat([[arb(float(y[i, j])) for j in range(n)] for i in range(n)])
-    hm = arb_mat([list(row) for row in hq])
+    hm = arb_mat(hq)
+    try:  # the preconditioner: the midpoint of the Hessian's inverse (any matrix is sound here)
+        ym = hm.mid().inv().mid()
+    except ZeroDivisionError:
+        return "unknown", ()
+    grad_m, _ = land.enclose(tuple(arb(v) for v in m), hessian=False)
     step = ym * arb_mat([[g] for g in grad_m])
-    ident = arb_mat([[1 if i == j else 0 for j in range(n)] for i in range(n)])
-    spread = (ident - ym * hm) * arb_mat([[balls[j] - m[j]] for j in range(n)])
+    spread = (_eye(n) - ym * hm) * arb_mat([[balls[j] - m[j]] for j in range(n)])
     k = [arb(m[j]) - step[j, 0] + spread[j, 0] for j in range(n)]
+    if not all(e.is_finite() for e in k):
+        return "unknown", tuple(k)
     if all(balls[j].contains_interior(k[j]) for j in range(n)):
         return "one", tuple(k)
     if any(not balls[j].overlaps(k[j]) for j in range(n)):
         return "none", tuple(k)
     return "unknown", tuple(k)
+
+
+_EYES: dict[int, object] = {}
+
+
+def _eye(n: int):
+    """The n x n identity as an arb_mat (made once)."""
+    from flint import arb_mat
+
+    if n not in _EYES:
+        _EYES[n] = arb_mat([[int(i == j) for j in range(n)] for i in range(n)])
+    return _EYES[n]
 
 
 def _close(centres: np.ndarray, q: tuple, margin: float) -> bool:
@@ -138,36 +164,34 @@ def _close(centres: np.ndarray, q: tuple, margin: float) -> bool:
 
 
 def enclosure_bounds(known: dict[int, tuple], n: int = 2) -> tuple[list[int], np.ndarray]:
-    """The known enclosures as float bounds, rounded outwards, with their copies one turn away:
-    (indices, array (known, 3^n, 2n) of lo1, hi1, lo2, hi2, ...)."""
+    """The known enclosures as float bounds, rounded outwards, with their copies one turn away
+    in each angle: (indices, array (known, n, 3, 2) of (lo, hi) per angle and turn -1, 0, 1)."""
     keys = list(known)
-    shifts = list(itertools.product((-1, 0, 1), repeat=n))
-    out = np.zeros((len(keys), len(shifts), 2 * n))
+    out = np.zeros((len(keys), n, 3, 2))
     for a, k in enumerate(keys):
-        lo = [math.nextafter(float(e.lower()), -math.inf) for e in known[k]]
-        hi = [math.nextafter(float(e.upper()), math.inf) for e in known[k]]
-        for b, shift in enumerate(shifts):
-            for j, s in enumerate(shift):
-                out[a, b, 2 * j : 2 * j + 2] = (lo[j] + s * TWO_PI, hi[j] + s * TWO_PI)
+        for j, e in enumerate(known[k]):
+            lo = math.nextafter(float(e.lower()), -math.inf)
+            hi = math.nextafter(float(e.upper()), math.inf)
+            for b, s in enumerate((-1, 0, 1)):
+                out[a, j, b] = (lo + s * TWO_PI, hi + s * TWO_PI)
     return keys, out
 
 
 def _where(bounds: tuple[list[int], np.ndarray], q: tuple) -> tuple[list[int], list[int]]:
-    """Known equilibria whose enclosure lies inside the box, and those it only touches.
+    """Known equilibria whose enclosure lies inside the box, and those it only touches (a copy
+    of it turned by whole turns in any angles: angle by angle, as the turns in each angle are
+    independent of the others').
 
     Float comparisons of outward-rounded bounds: a 'not inside' may be conservative (the box is
     then split), never an 'inside' that is not."""
     keys, b = bounds
     if not keys:
         return [], []
-    inside = np.ones(b.shape[:2], dtype=bool)
-    touch = np.ones(b.shape[:2], dtype=bool)
-    for j in range(len(q) // 2):
-        lo, hi = q[2 * j], q[2 * j + 1]
-        inside &= (lo < b[..., 2 * j]) & (b[..., 2 * j + 1] < hi)
-        touch &= (b[..., 2 * j] <= hi) & (lo <= b[..., 2 * j + 1])
-    ins, tou = inside.any(axis=1), touch.any(axis=1)
-    return [keys[a] for a in np.flatnonzero(ins)], [keys[a] for a in np.flatnonzero(tou & ~ins)]
+    lo, hi = np.array(q[0::2])[None, :, None], np.array(q[1::2])[None, :, None]
+    inside = ((lo < b[..., 0]) & (b[..., 1] < hi)).any(axis=2).all(axis=1)
+    touch = ((b[..., 0] <= hi) & (lo <= b[..., 1])).any(axis=2).all(axis=1)
+    return [keys[a] for a in np.flatnonzero(inside)], [
+        keys[a] for a in np.flatnonzero(touch & ~inside)]  # fmt: skip
 
 
 def spring_length_squares(params: Params, pa, g1, g2) -> list:
@@ -191,14 +215,29 @@ def _short(lengths: list, limit) -> str:
     return verdict
 
 
-def _split(q: tuple) -> list[tuple]:
-    """The 2^n halves-in-every-angle of a box."""
+def _split(q: tuple, balls: tuple | None = None) -> list:
+    """A box halved along its MAX_CUTS widest sides (those at least half as wide as its widest;
+    in one or two angles: every side). In four angles a box cut along every side makes 16 boxes
+    where the first halvings would often have excluded half of them. With `balls` (box(*q)):
+    each half as (bounds, its balls), the balls of the sides not cut kept."""
+    from flint import arb
+
+    n = len(q) // 2
+    widths = [q[2 * j + 1] - q[2 * j] for j in range(n)]
+    order = sorted(range(n), key=lambda j: -widths[j])[:MAX_CUTS]
+    cut = [j for j in order if widths[j] >= 0.5 * widths[order[0]]]
     halves = []
-    for j in range(len(q) // 2):
+    for j in range(n):
         lo, hi = q[2 * j], q[2 * j + 1]
-        mid = (lo + hi) / 2
-        halves.append(((lo, mid), (mid, hi)))
-    return [tuple(v for pair in choice for v in pair) for choice in itertools.product(*halves)]
+        if j in cut:
+            mid = (lo + hi) / 2
+            halves.append((((lo, mid), _interval(arb, lo, mid)),
+                           ((mid, hi), _interval(arb, mid, hi))))  # fmt: skip
+        else:
+            halves.append((((lo, hi), balls[j] if balls else None),))
+    out = [(tuple(v for (pair, _) in choice for v in pair), tuple(b for _, b in choice))
+           for choice in itertools.product(*halves)]  # fmt: skip
+    return out if balls else [bounds for bounds, _ in out]
 
 
 def branch_and_bound(
@@ -217,9 +256,10 @@ def torus_search(
     known: dict[int, tuple],
     short: float,
     min_width: float,
-    start: int = 16,
+    start: int | None = None,
 ) -> TorusProof:
-    """Decide every box of the torus [0, 2 pi]^n (see the module docstring). Boxes where a
+    """Decide every box of the torus [0, 2 pi]^n, from a grid of `start` boxes an angle (16 in
+    one or two angles, 8 in more; see the module docstring). Boxes where a
     spring with L0 > 0 is shorter than `short` are set aside (split to `min_width` where they
     may only be); `proof.longest_excluded` bounds the spring length over them, and
     `proof.shortest_length` the spring lengths from below over every other box."""
@@ -232,18 +272,21 @@ def torus_search(
     proof = TorusProof({k: [] for k in known}, [], [], [])
     centres = np.array([[float(e.mid()) for e in v] for v in known.values()])
     bounds = enclosure_bounds(known, land.n)
+    start = start or (16 if land.n <= 2 else 8)
     edges = np.linspace(0.0, TWO_PI, start + 1)
     cells = list(zip(edges[:-1], edges[1:], strict=True))
-    stack = [tuple(v for c in choice for v in c) for choice in itertools.product(cells,
-             repeat=land.n)]  # fmt: skip
+    stack = [(q, box(*q)) for q in (tuple(v for c in choice for v in c)
+             for choice in itertools.product(cells, repeat=land.n))]  # fmt: skip
     # How far: the share of the torus in boxes decided (neither on the stack nor split).
     report, pending = Progress("certificate search", 1.0, "of the poses decided"), 1.0
+    low_square = math.inf  # at most the square of every spring's length over every leaf
     while stack:
-        report.set(1.0 - pending, note=f"{proof.boxes} boxes")
-        q = stack.pop()
-        pending -= _share(q)
+        if not proof.boxes % 32:  # a line costs more than a box: not every box
+            report.set(1.0 - pending, note=f"{proof.boxes} boxes")
+        q, balls = stack.pop()
+        share = _share(q)
+        pending -= share
         proof.boxes += 1
-        balls = box(*q)
         width = max(q[2 * j + 1] - q[2 * j] for j in range(land.n))
         lengths = land.lengths(balls)
         near = _short(lengths, limit if width > min_width else wide)
@@ -252,20 +295,29 @@ def torus_search(
             shortest = min(float(dd.upper()) for dd in lengths)
             proof.longest_excluded = max(proof.longest_excluded, math.sqrt(shortest))
             continue
-        outcome = _visit(land, q, balls, not near, (bounds, centres, min_width), proof)
+        outcome = _visit(land, (q, balls, width), not near, (bounds, centres, min_width), proof)
         if outcome != "done":
             floor = ROOT_MIN_WIDTH if outcome == "root" else _floor(lengths, min_width,
                                                                     land.length_unit)  # fmt: skip
             if width > floor:
-                stack.extend(_split(q))
-                pending += _share(q)
+                stack.extend(_split(q, balls))
+                pending += share
                 continue
             proof.undecided.append(q)
         # A leaf of the search (decided or undecided): its lengths bound them from below.
-        proof.shortest_length = min(proof.shortest_length, length_floor(lengths))
+        for dd in lengths:
+            low_square = min(low_square, math.nextafter(float(dd.lower()), -math.inf))
     report.set(1.0, note=f"{proof.boxes} boxes")  # the stack is empty: every box decided
     report.close()
+    proof.shortest_length = _root_down(low_square)
     return proof
+
+
+def _root_down(square: float) -> float:
+    """A float at most the square root of `square` (0 for a square at most 0, inf for inf)."""
+    if square == math.inf:
+        return math.inf
+    return math.nextafter(math.sqrt(square), 0.0) if square > 0 else 0.0
 
 
 def _share(q: tuple) -> float:
@@ -285,19 +337,21 @@ def length_floor(squares: list) -> float:
     return math.nextafter(out, 0.0) if 0 < out < math.inf else out
 
 
-def _visit(land: Landscape, q: tuple, balls: tuple, smooth: bool, known: tuple,
-           proof: TorusProof) -> str:  # fmt: skip
+def _visit(land: Landscape, where: tuple, smooth: bool, known: tuple, proof: TorusProof) -> str:
     """'done' (the box holds no critical point, or one matched to a known equilibrium, or one
     recorded as missing), 'split', or 'root' (split on down to ROOT_MIN_WIDTH: a known
-    equilibrium is in or near the box; undecided below it). `smooth`: every spring with a free
-    length is longer than the limit over the box; `known`: (enclosure bounds, centres,
-    min_width)."""
+    equilibrium is in or near the box; undecided below it). `where`: (the box's bounds, its
+    balls, its widest side); `smooth`: every spring with a free length is longer than the limit
+    over the box; `known`: (enclosure bounds, centres, min_width)."""
     if not smooth:
         return "split"
+    q, balls, width = where
     grad, _ = land.enclose(balls, hessian=False)
     if not all(g.contains(0) for g in grad):
         return "done"
-    verdict, _k = krawczyk_box(land, q)
+    if width > KRAWCZYK_WIDTH:
+        return "split"
+    verdict, _k = krawczyk_box(land, q, balls)
     if verdict == "none":
         return "done"
     bounds, centres, min_width = known

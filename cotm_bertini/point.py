@@ -462,6 +462,8 @@ def _solve_real(
                            found.roots)  # fmt: skip
         descents = _descents(land, found, seeds, settings.seed)
         seeds = np.vstack([seeds, land.fresh(descents["points"], np.vstack([found.roots, seeds]))])
+        regions = free_regions(land, found, unit)
+        seeds = seeds[~in_regions(land, seeds, regions, unit)]
         groups = land.endpoints(np.vstack([found.roots, seeds]))
     report: dict = {" ".join(taut) or "none": {"excluded": True, "pruned": "bound smoothing",
                     "note": why.note()} for taut, why in pruned.items()}  # fmt: skip
@@ -473,13 +475,20 @@ def _solve_real(
         checks = completeness(fw, table, report, continua, near_cones=found.set_aside_boxes)
     morse_bott = all(c.index is not None for c in continua)
     search_info = real_search_info(found, unit[0], along_continua(land, found, continua),
-                                   morse_bott)  # fmt: skip
+                                   morse_bott, regions)  # fmt: skip
     search_info["found_by_newton"] = len(seeds)
     if descents["starts"]:
         search_info["descents"] = {k: v for k, v in descents.items() if k != "points"}
     warnings = tuple(search_info["warnings"] + checks["warnings"])
     status = STATUS_INCOMPLETE if warnings else STATUS_OK
     failure = checks["morse"].get("failure")
+    if failure and search_info["free_regions"]:
+        # A region of equilibria has no term in the Morse sum: the count says nothing here.
+        checks["morse"].update(
+            applicable=False, ok=None, reason="a region of equilibria (a node free to float)"
+        )
+        warnings = tuple(w for w in warnings if not w.startswith(failure))
+        status, failure = (STATUS_INCOMPLETE if warnings else STATUS_OK), None
     if failure and not search_info["warnings"]:
         # The search proved its rows are every critical point; the Morse count, which shares
         # none of its code, says they are not: one of the two is wrong, and no later check
@@ -563,11 +572,12 @@ def along_continua(land, found, continua: list) -> int:
     return int(near.sum())
 
 
-def real_search_info(found, length_unit: float, along: int = 0, morse_bott: bool = False) -> dict:
+def real_search_info(found, length_unit: float, along: int = 0, morse_bott: bool = False,
+                     free: list | None = None) -> dict:  # fmt: skip
     """The real search's record for run.json: what was decided, set aside and left, and the
     warnings a search that is not a proof gives (`along`: undecided boxes that lie along a
     continuum of equilibria, which no box test can decide; `morse_bott`: every continuum has a
-    nondegenerate Hessian across it)."""
+    nondegenerate Hessian across it; `free`: free_regions' regions of equilibria)."""
     warnings = []
     if len(found.undecided) > along:
         warnings.append(
@@ -590,15 +600,14 @@ def real_search_info(found, length_unit: float, along: int = 0, morse_bott: bool
         )  # fmt: skip
     if found.newton_failed:
         warnings.append(f"{found.newton_failed} proved critical points not reached by Newton")
-    free = _free_regions(found)
-    if free:
-        warnings.append(
-            "V is flat over regions of poses where a node has every cable slack and no load: "
-            + "; ".join(f"angles {r['free_angles']} free, {r['pieces']} boxes, the other "
-                        f"angles at one equilibrium" for r in free)
-            + ": a continuum of equilibria there, not listed as rows"
-            + (f" ({found.edge} boxes at its edges left undecided)" if found.edge else "")
-        )  # fmt: skip
+    free = free or []
+    for r in free:
+        if not r["witnessed"]:
+            warnings.append(f"region {r['region']}: no pose of it was seen with every cable of "
+                            f"{', '.join(r['free_nodes'])} slack (it may be empty)")  # fmt: skip
+    if found.edge:
+        warnings.append(f"{found.edge} boxes at the edges of regions of equilibria left "
+                        "undecided (a cable there may be taut or slack)")  # fmt: skip
     return {
         "boxes": found.boxes,
         "seconds": round(found.seconds, 4),
@@ -621,21 +630,69 @@ def real_search_info(found, length_unit: float, along: int = 0, morse_bott: bool
     }
 
 
-def _free_regions(found) -> list[dict]:
-    """The search's free pieces grouped by which angles are free and where the other angles'
-    equilibrium is (to 1e-8 rad): one region each, with its pieces and that point."""
+def free_regions(land, found, unit: tuple[float, float]) -> list[dict]:
+    """The search's free pieces grouped into regions of equilibria: the same nodes free and
+    the others at the same pose (to 1e-8); each with its free and held nodes, the held ones'
+    coordinates (file units), V there (file units), its pieces, and whether one piece's middle
+    has every cable of the free nodes slack (a pose of the region seen: `witnessed`)."""
     out: list[dict] = []
     if not len(found.free_boxes):
         return out
-    for mask, x in zip(found.free_masks, found.free_points, strict=True):
-        angles = [int(i) for i in np.flatnonzero(mask)]
-        same = next((r for r in out if r["free_angles"] == angles
-                     and np.abs(np.asarray(r["point_rad"]) - x)[~mask].max(initial=0) < 1e-8),
-                    None)  # fmt: skip
+    X, lengths = land.positions(found.free_points), land.cable_lengths(found.free_points)
+    free_length = {x.name: x.L0 for x in land.links}
+    floating = land.floating()
+    for k, (mask, x) in enumerate(zip(found.free_masks, X, strict=True)):
+        free = [i for i in range(len(land.nodes)) if mask[2 * i]]
+        # V over the region: its free nodes' cables slack (the piece's middle may not be).
+        cut = tuple(c for i in free for c in floating.get(i, []))
+        v = land.energy(found.free_points[k : k + 1], cut)[0] * unit[1] * unit[0] ** 2
+        held = [i for i in range(len(land.nodes)) if not mask[2 * i]]
+        pose = np.concatenate([x[3 * i : 3 * i + 3] for i in held]) if held else np.zeros(0)
+        slack = _witness(land, found, k, cut, free_length) or all(
+            lengths[c][k] < free_length[c] for c in cut)  # fmt: skip
+        same = next((r for r in out if r["free_nodes"] == [land.nodes[i] for i in free]
+                     and np.abs(r["_pose"] - pose).max(initial=0) < 1e-8), None)  # fmt: skip
         if same is None:
-            out.append({"free_angles": angles, "pieces": 1, "point_rad": x.round(12).tolist()})
+            out.append({"region": len(out) + 1, "free_nodes": [land.nodes[i] for i in free],
+                        "held_nodes": [land.nodes[i] for i in held],
+                        "held_pose": (pose * unit[0]).round(12).tolist(), "energy": float(v),
+                        "pieces": 1, "witnessed": slack, "_pose": pose})  # fmt: skip
         else:
             same["pieces"] += 1
+            same["witnessed"] |= slack
+    return [{k: v for k, v in r.items() if k != "_pose"} for r in out]
+
+
+def _witness(land, found, k: int, cables: tuple[str, ...], L0: dict, tries: int = 64) -> bool:
+    """Whether some pose of free piece k (its free angles drawn over the box, the others at
+    its point) has every cable of `cables` slack: a pose of the region seen."""
+    n = land.n
+    box, x, mask = found.free_boxes[k], found.free_points[k], found.free_masks[k]
+    u = np.random.default_rng(k).random((tries, n))
+    pts = np.where(mask, box[:n] + u * (box[n:] - box[:n]), x)
+    lengths = land.cable_lengths(pts)
+    return bool(np.all([lengths[c] < L0[c] for c in cables], axis=0).any())
+
+
+def in_regions(land, points: np.ndarray, regions: list[dict], unit) -> np.ndarray:
+    """Which points (Newton's, from undecided boxes) lie in a reported region of equilibria:
+    its free nodes' cables all slack there and the other nodes at its pose (to 1e-7): rows of
+    it, not equilibria apart."""
+    out = np.zeros(len(points), dtype=bool)
+    if not regions or not len(points):
+        return out
+    X, lengths = land.positions(points), land.cable_lengths(points)
+    L0, floating = {x.name: x.L0 for x in land.links}, land.floating()
+    for r in regions:
+        free = [land.nodes.index(v) for v in r["free_nodes"]]
+        held = [land.nodes.index(v) for v in r["held_nodes"]]
+        slack = np.ones(len(points), dtype=bool)
+        for i in free:
+            for c in floating.get(i, []):
+                slack &= lengths[c] < L0[c]
+        pose = X[:, [3 * i + c for i in held for c in range(3)]]
+        near = np.abs(pose - np.asarray(r["held_pose"]) / unit[0]).max(axis=1, initial=0) < 1e-7
+        out |= slack & near
     return out
 
 

@@ -92,13 +92,27 @@ def test_prism_saddle_is_proved_with_its_global_minimum():
 
 def test_a_node_free_to_float_is_reported_as_a_region_and_the_search_finishes():
     """Node B hangs with one cable and no load: where that cable is slack V is flat along B,
-    a region of equilibria. The search finishes in seconds, names the free angles (B's) and
-    the other node's equilibrium there, and says the status is incomplete, not ok."""
+    a region of equilibria for each equilibrium of A alone (its own cable and load: Newton
+    on tensegrity_physics' statics of A without B). Where B's cable is taut, B's equilibrium
+    is its pose farthest from the cable's anchor (the pull along the bar), a row with each of
+    A's. The search proves both: regions with A's poses and energies, rows, status ok."""
     fw = cb.Framework.from_toml(ROOT / "tests" / "fixtures" / "floppy_node.toml")
     res = cb.solve(fw, cache=False)
-    search = res.record["details"]["real_search"]
-    assert res.status == "incomplete"
-    regions = search["free_regions"]
-    assert regions and all(r["free_angles"] == [2, 3] for r in regions)
-    assert any("V is flat over regions" in w for w in res.warnings)
-    assert search["seconds"] < 60
+    assert res.status == "ok", res.warnings
+    alone = tp.Spatial({"a": (1.0, 0.0, 0.0), "c": (-0.5, -0.9, 0.0)}, ("A",),
+                       (("a", "A", 1.0),), (("ca", "A", "c", 1.0, 0.8),),
+                       loads=(("A", (0.0, 0.1, -0.2)),))  # fmt: skip
+    ref = tp.critical_points(alone, starts=400)
+    regions = res.record["details"]["real_search"]["free_regions"]
+    assert len(regions) == len(ref) >= 2
+    for p in ref:
+        (r,) = [r for r in regions if np.abs(np.asarray(r["held_pose"]) - p["X"]).max() < 1e-7]
+        assert r["free_nodes"] == ["B"] and r["witnessed"]
+        assert math.isclose(r["energy"], p["energy"], rel_tol=1e-9, abs_tol=1e-12)
+    rows = res.physical
+    X = rows[["A.x", "A.y", "A.z", "B.x", "B.y", "B.z"]].to_numpy(float)
+    far = np.array([-0.5, 1.9, 0.0])  # ground.b + its bar's length away from ground.c
+    assert len(rows) == len(ref)
+    for p in ref:
+        assert np.abs(X - np.concatenate([p["X"], far])).max(axis=1).min() < 1e-7
+    assert res.record["details"]["real_search"]["seconds"] < 60

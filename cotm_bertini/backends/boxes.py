@@ -45,7 +45,8 @@ NEAR_CONDITION = 1e10  # a critical point worth splitting below MIN_WIDTH for is
 ROOT_FLOOR = 1e-10  # radians: boxes are not split below this, whatever a spring's length
 MAX_CUTS = 2  # sides halved at a split (see _split)
 KRAWCZYK_BATCH = 1024  # boxes for the Krawczyk test wait until this many are pending
-FREE, EDGE = 2, 1  # landscape.free's codes: an angle V is flat along, or may be (see _step)
+# landscape.free's codes: an angle V is flat along, or may be, or no critical point in the box
+FREE, EDGE, NONE = 2, 1, -1
 EDGE_WIDTH = 0.05  # radians: a box at the edge of a free region this small is left undecided
 
 
@@ -66,9 +67,11 @@ class BoxLandscape(Protocol):
 
     # Optional: `domain(start) -> (lo, hi)`, the boxes that cover the configuration space
     # (charts of a sphere, say); without it the torus grid of `initial_boxes`.
-    # Optional: `free(states, B) -> (B, n) int`, FREE for the angles grad V cannot depend on
-    # over each box, its components along them 0 whatever the angles (a node with every element
-    # slack and no load), EDGE where that may be so: see _step.
+    # Optional: `free(box, states) -> (code (B, n) int, slack)`: FREE for the angles along
+    # which grad V is 0 at every critical point in the box whatever they are (a node with its
+    # every element slack and no load), with the cables to take as slack there (`slack`, name
+    # -> (B,) bool, for enclose(box, slack) and the states hessian reads); EDGE where that may
+    # be so but is not proved; NONE where no critical point is in the box: see _step.
 
 
 class BoxFamily(Protocol):
@@ -458,7 +461,9 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, testing) -
     rows = np.arange(len(lo))
     dd, grad, states = land.enclose(box)
     # Along free angles grad V is 0 whatever they are: the box is searched in the others.
-    code = _free(land, states, lo.shape)
+    code, slack = _free(land, box, states)
+    if slack:  # those boxes' critical points have these cables slack: V as it is there
+        dd, grad, states = land.enclose(box, slack=slack)
     free = code == FREE
     width = np.where(free, 0.0, hi - lo).max(axis=1)
     # At the edge of a free region (a node's cables may all be slack) every box holds
@@ -477,14 +482,15 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, testing) -
     found = (rows[:0], np.zeros((0, n)), np.zeros((0, 2 * n)), np.zeros(0, dtype=bool))
     pieces = (rows[:0], np.zeros((0, 4 * n)))
     if len(test):
-        zero = grad[test].contains_zero().all(axis=1)
+        zero = grad[test].contains_zero().all(axis=1) & ~(code[test] == NONE).any(axis=1)
         decided[test[~zero]] = True
         cand = test[zero & (width[test] <= KRAWCZYK_WIDTH)]
         later[cand[~testing[cand]]] = True
         cand = cand[testing[cand]]
         if len(cand):
             verdict, k_lo, k_hi = krawczyk(_sub(land, cand), lo[cand], hi[cand],
-                                           _subset(states, cand), free[cand])  # fmt: skip
+                                           _subset(states, cand), free[cand],
+                                           _subset(slack, cand))  # fmt: skip
             decided[cand[verdict != 0]] = True
             flat = free[cand].any(axis=1)
             one = (verdict == 1) & ~flat
@@ -597,15 +603,16 @@ def _split(lo: np.ndarray, hi: np.ndarray, parent: np.ndarray, free=None) -> tup
     return lo, hi, parent
 
 
-def krawczyk(land: BoxLandscape, lo: np.ndarray, hi: np.ndarray, states, free=None) -> tuple:
+def krawczyk(land: BoxLandscape, lo, hi, states, free=None, slack=None) -> tuple:
     """(verdict, K lo, K hi) per box: 1 exactly one critical point (in K), -1 none, 0 unknown.
     Along `free` angles ((B, n) bool) grad V is 0 whatever they are: the test is that of the
     other components in the other angles (their gradient does not depend on the free ones over
     the box), and a 1 says each value of the free angles has exactly one critical point of the
-    others, the same one (the free angles of K are the box's middle)."""
+    others, the same one (the free angles of K are the box's middle). `slack`: the cables
+    the landscape takes as slack over each box (its `free`), at the middle too."""
     n = lo.shape[1]
     mid = 0.5 * (lo + hi)
-    _, g_mid, _ = land.enclose(Interval(mid))
+    _, g_mid, _ = land.enclose(Interval(mid), slack=slack) if slack else land.enclose(Interval(mid))
     h = land.hessian(Interval(lo, hi), states)
     if free is None or not free.any():
         free = np.zeros(lo.shape, dtype=bool)
@@ -655,10 +662,13 @@ def _roots(land: BoxLandscape, lo, hi, k_lo, k_hi, steps: int = 40) -> tuple:
     return x, np.hstack([lo, hi]), good
 
 
-def _free(land, states, shape: tuple) -> np.ndarray:
-    """(B, n) the angles grad V is 0 along whatever they are, over each box (landscape.free)."""
+def _free(land, box: Interval, states) -> tuple[np.ndarray, dict]:
+    """(code (B, n), slack) of landscape.free over each box (none free without it)."""
     rule = getattr(land, "free", None)
-    return np.zeros(shape, dtype=bool) if rule is None else rule(states, shape[0])
+    if rule is None:
+        return np.zeros(box.lo.shape, dtype=np.int8), {}
+    code, slack = rule(box, states)
+    return code, {c: m for c, m in slack.items() if m.any()}
 
 
 def _free_points(land, lo, hi, k_lo, k_hi, free, steps: int = 40) -> np.ndarray:

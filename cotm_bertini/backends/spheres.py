@@ -34,7 +34,7 @@ from ..model.framework.reach import sphere_chain
 from ..model.framework.spec import Framework, owner
 from ..model.framework.units import normalized_slots
 from ..model.intervals import Interval, stack
-from .boxes import EDGE, FREE, OFFSET
+from .boxes import EDGE, FREE, NONE, OFFSET
 from .endpoints import Endpoints
 from .links import (
     EITHER,
@@ -148,21 +148,70 @@ class SphereFramework:
         hi = np.array([[v for i in row for v in (parts[i][0][1], parts[i][1][1])] for row in idx])
         return lo, hi
 
-    def free(self, states: dict, count: int) -> np.ndarray:
-        """(B, n) per chart angle over each box: FREE where grad V is 0 along it whatever it
-        is (a node's two angles, where every element joining what hangs from it to the rest is
-        a cable that is slack over the box and no load acts on what hangs from it: V is flat
-        there), EDGE where that node may be so (no such cable certainly taut), else 0."""
-        out = np.zeros((count, self.n), dtype=np.int8)
-        for i, cables in self._floating().items():
-            slack, loose = np.ones(count, dtype=bool), np.ones(count, dtype=bool)
+    def free(self, box: Interval, states: dict) -> tuple[np.ndarray, dict]:
+        """(code (B, n), slack) over boxes. A node with no load on what hangs from it feels the
+        rest only through the cables joining the two; where each is slack over a box, grad V
+        is 0 along the node's two angles whatever they are (code FREE: V is flat there). Where
+        some may be taut (none is certainly), a critical point in the box has them all slack,
+        or a taut one balanced by the others (sum w_c v_c = 0, w_c >= 0, v_c the pull of
+        cable c in the node's angles): where one direction has every such v_c on its positive
+        side the second cannot be, so every critical point has the node's cables slack, and
+        the box is FREE with them taken as slack (`slack`: name -> (B,) bool). Else EDGE.
+        Where one is certainly taut and the pulls so lie, no critical point is in the box at
+        all (code NONE): near the edge of a free region the pulls are weak, and the enclosure
+        of grad V alone would exclude such boxes only when they are very small."""
+        count = box.lo.shape[0]
+        code, slack = np.zeros((count, self.n), dtype=np.int8), {}
+        for i, cables in self.floating().items():
+            certain, loose = np.ones(count, dtype=bool), np.ones(count, dtype=bool)
             for c in cables:
-                slack &= states[c] == SLACK
+                certain &= states[c] == SLACK
                 loose &= states[c] != TAUT
-            out[:, 2 * i : 2 * i + 2] = np.where(slack, FREE, np.where(loose, EDGE, 0))[:, None]
-        return out
+            rows = np.flatnonzero(~certain)
+            none = np.zeros(count, dtype=bool)
+            if len(rows):
+                sub = {c: states[c][rows] for c in cables}
+                one_side = rows[self._unbalanced(box[rows], i, cables, sub)]
+                none[one_side[~loose[one_side]]] = True
+                certain[one_side[loose[one_side]]] = True
+            code[:, 2 * i : 2 * i + 2] = np.where(
+                none | (code[:, 2 * i] == NONE), NONE,
+                np.where(certain, FREE, np.where(loose, EDGE, 0)))[:, None]  # fmt: skip
+            if certain.any():
+                for c in cables:
+                    slack[c] = slack.get(c, np.zeros(count, dtype=bool)) | certain
+        return code, slack
 
-    def _floating(self) -> dict[int, list[str]]:
+    def _unbalanced(self, box: Interval, i: int, cables: list[str], states: dict) -> np.ndarray:
+        """Per box: whether the pulls in node i's angles of its cables that may be taut lie
+        strictly on one side of a line (no taut balance: `free`)."""
+        # (Each such cable's pull is the gradient of |r|^2 / 2 in the node's angles; its force
+        # adds w >= 0 times it, w > 0 where it is taut.)
+        count = box.lo.shape[0]
+        positions, dirs = self.kinematics(box, second=False)
+        first = ball_module(self.full).first_order(self.pose(positions, count), self.P)
+        m, per, v = len(positions), 3 + 3 * len(positions), self.nodes[i]
+        pulls = []
+        for k, x in enumerate(self.links):
+            if x.name not in cables or not (states[x.name] != SLACK).any():
+                continue
+            r, dr = first[k * per : k * per + 3], first[k * per + 3 : (k + 1) * per]
+            g = [interval_sum([Interval(np.zeros(count)) + 0.0]
+                              + [Interval.of(r[c]) * dr[c * m + j] for c in range(3)
+                                 if not _zero(dr[c * m + j])]) for j in range(m)]  # fmt: skip
+            G = self.pull(g, v)
+            pull = [self.length[v] * _dot(dirs[i][key], G) for key in ("ua", "ub")]
+            pulls.append((states[x.name] != SLACK, pull))
+        if not pulls:
+            return np.ones(count, dtype=bool)
+        e = sum(np.where(on[:, None], np.stack([p[0].mid, p[1].mid], 1), 0.0) for on, p in pulls)
+        ok = np.ones(count, dtype=bool)
+        for on, p in pulls:
+            side = p[0] * e[:, 0] + p[1] * e[:, 1]
+            ok &= ~on | (side.lo > 0)
+        return ok
+
+    def floating(self) -> dict[int, list[str]]:
         """Per node that can float: the cables whose slackness frees it (module `free`)."""
         touches = [set(np.flatnonzero(np.abs(s).sum(axis=0)) // 3) for s in self.stencil]
         loaded = {ld.point for ld in self.fw.loads
@@ -216,8 +265,9 @@ class SphereFramework:
             X[j] = p
         return X
 
-    def node_gradient(self, positions: list, count: int):
-        """(g in node coordinates, squared lengths per link, cable states) over boxes."""
+    def node_gradient(self, positions: list, count: int, slack: dict | None = None):
+        """(g in node coordinates, squared lengths per link, cable states) over boxes; the
+        cables of `slack` (name: (B,) bool) taken slack where it says so (see `free`)."""
         first = ball_module(self.full).first_order(self.pose(positions, count), self.P)
         m, per = len(positions), 3 + 3 * len(positions)
         g = [Interval(np.zeros(count)) + v for v in first[len(self.links) * per :]]
@@ -226,6 +276,10 @@ class SphereFramework:
             r, dr = first[i * per : i * per + 3], first[i * per + 3 : (i + 1) * per]
             dd = interval_sum(Interval.of(c) * c for c in r)
             w, state = force_density(x, dd)
+            if slack and x.name in slack:
+                off = slack[x.name]
+                w = Interval(np.where(off, 0.0, w.lo), np.where(off, 0.0, w.hi))
+                state = np.where(off, SLACK, state)
             if x.cable:
                 states[x.name] = state
             wr = [w * c for c in r]  # w r once: dr/dX of a node's coordinate is +-1 or 0
@@ -236,11 +290,12 @@ class SphereFramework:
             dds.append(dd)
         return g, dds, states
 
-    def enclose(self, box: Interval) -> tuple[Interval, Interval, dict]:
-        """(squared lengths of the free-length springs, grad V in chart angles, cable states)."""
+    def enclose(self, box: Interval, slack: dict | None = None) -> tuple:
+        """(squared lengths of the free-length springs, grad V in chart angles, cable states),
+        the cables of `slack` taken slack where it says so."""
         count = box.lo.shape[0]
         positions, dirs = self.kinematics(box, second=False)
-        g, dds, states = self.node_gradient(positions, count)
+        g, dds, states = self.node_gradient(positions, count, slack)
         grad = []
         for i, v in enumerate(self.nodes):
             G = self.pull(g, v)
@@ -265,8 +320,8 @@ class SphereFramework:
         """A slope matrix of grad V over each box (B, n, n) (module docstring)."""
         count = box.lo.shape[0]
         positions, dirs = self.kinematics(box)
-        g, _, _ = self.node_gradient(positions, count)
-        H = self.node_hessian(positions, count)
+        g, _, _ = self.node_gradient(positions, count, _slack_of(states))
+        H = self.node_hessian(positions, count, states)
         J = stack([stack(row, axis=1) for row in self.jacobian(dirs, count)], axis=1)
         JT = Interval(np.swapaxes(J.lo, 1, 2), np.swapaxes(J.hi, 1, 2))
         HJ = (H[:, :, :, None] * J[:, None, :, :]).isum(axis=2)
@@ -286,7 +341,7 @@ class SphereFramework:
             raise ValueError(f"{self.fw.name}: a link's ends move other than as nodes")
         return dr[0].reshape(len(self.links), 3, m)
 
-    def node_hessian(self, positions: list, count: int) -> Interval:
+    def node_hessian(self, positions: list, count: int, states: dict) -> Interval:
         """The Hessian of V in node coordinates over boxes (B, m, m), summed link by link from
         each link's r and its state there: a slack cable adds nothing, one that may be either
         the hull of nothing and its taut term. (The generated Hessian has every cable taut,
@@ -297,7 +352,7 @@ class SphereFramework:
         blocks: dict[tuple[int, int], Interval] = {}
         for i, x in enumerate(self.links):
             r = stack([Interval(np.zeros(count)) + first[i * per + c] for c in range(3)], axis=1)
-            M = _link_block(x, r)
+            M = _link_block(x, r, states.get(x.name))
             for j, sj in self.ends[i]:
                 for q, sq in self.ends[i]:
                     t = M if sj == sq else -M
@@ -367,6 +422,23 @@ class SphereFramework:
     def cable_lengths(self, x: np.ndarray) -> dict[str, np.ndarray]:
         """Each link's length at points (R, n chart angles), normalised units as `links`' L0."""
         return self._numeric(x)[4]
+
+    def energy(self, x: np.ndarray, slack: tuple[str, ...] = ()) -> np.ndarray:
+        """V at points (R, n chart angles), normalised units: the springs' and taut cables'
+        energies less the loads' work; the cables `slack` left out (taken slack)."""
+        X, d = self.positions(x), self._numeric(x)[4]
+        V = np.zeros(len(x))
+        for link in (x for x in self.links if x.name not in slack):
+            stretch = d[link.name] - (link.L0 or 0.0)
+            if link.cable:
+                stretch = np.maximum(stretch, 0.0)
+            V += 0.5 * link.k * stretch**2
+        for load in self.fw.loads:
+            if load.point in self.nodes:
+                i = self.nodes.index(load.point)
+                F = [self.slots[f"f_{load.name}_{c}"] for c in "xyz"]
+                V -= X[:, 3 * i : 3 * i + 3] @ np.asarray(F)
+        return V
 
     def positions(self, x: np.ndarray) -> np.ndarray:
         """Node coordinates (R, 3 per node) at points (R, n chart angles)."""
@@ -452,15 +524,20 @@ class SphereFramework:
         return found_endpoints(fs.ps.variables, values, np.arange(len(X)))
 
 
-def _link_block(x, r: Interval) -> Interval:
+def _link_block(x, r: Interval, state=None) -> Interval:
     """The Hessian of a link's energy in its r = a - b over boxes (B, 3) -> (B, 3, 3): k I
-    without a free length; else w I + k L0 r r^T / d^3, w the force density; a cable's r r^T
-    term hulled with 0 where it may be slack, 0 where it is (w is so already)."""
+    without a free length; else w I + k L0 r r^T / d^3, w the force density; a cable's terms
+    hulled with 0 where it may be slack, 0 where it is (`state`: the box's, where given: a
+    cable the search takes as slack (see SphereFramework.free) is slack)."""
     eye = np.eye(3)[None]
     if x.L0 is None:
         return Interval(np.broadcast_to(x.k * eye, (r.lo.shape[0], 3, 3)).copy())
     dd = r.square().isum(axis=1)
-    w, state = force_density(x, dd)
+    w, own = force_density(x, dd)
+    if state is None:
+        state = own
+    elif (off := (state == SLACK) & (own != SLACK)).any():
+        w = Interval(np.where(off, 0.0, w.lo), np.where(off, 0.0, w.hi))
     t = (x.k * x.L0) / (dd.sqrt() * dd)
     outer = Interval(r.lo[:, :, None], r.hi[:, :, None]) * Interval(
         r.lo[:, None, :], r.hi[:, None, :]
@@ -476,6 +553,11 @@ def _link_block(x, r: Interval) -> Interval:
             np.where(slack, 0.0, np.where(either, np.maximum(T.hi, 0.0), T.hi)),
         )
     return T + Interval(w.lo[:, None, None] * eye, w.hi[:, None, None] * eye)
+
+
+def _slack_of(states: dict) -> dict:
+    """The cables' slack masks from their states (what `free` takes as slack is SLACK)."""
+    return {c: v == SLACK for c, v in states.items()}
 
 
 def _dot(u: list, v: list):

@@ -62,6 +62,8 @@ def summary_head(record: dict, cached: bool = False) -> str:
     if cached:
         seconds = f"(cached: {seconds} when solved on {record.get('solved', '?')})"
     apart = f"; {continua} continua of equilibria apart" if continua else ""
+    regions = len(record.get("details", {}).get("real_search", {}).get("free_regions", []))
+    apart += f"; {regions} {_plural(regions, 'region')} of equilibria apart" if regions else ""
     if engine["flavour"] == "real":
         return (
             f"{c['physical']} equilibria ({c['stable']} stable{apart}; {c['distinct_solutions']}"
@@ -88,7 +90,22 @@ def summary_text(record: dict, table: dict) -> str:
         lines.append(f"{others} other {_plural(others, 'row')} in the run folder's solutions.csv "
                      f"({_others_text(table)}; its column reason says why)")  # fmt: skip
     lines += [continuum_line(c) for c in record.get("continua", [])]
+    regions = record.get("details", {}).get("real_search", {}).get("free_regions", [])
+    lines += [region_line(r) for r in regions]
     return "\n".join(lines)
+
+
+def region_line(r: dict) -> str:
+    """A region of equilibria in a line: the nodes free to float, the others' pose, V."""
+    held = ", ".join(r["held_nodes"])
+    return (
+        f"region {r['region']}: {', '.join(r['free_nodes'])} free to float (every cable slack "
+        f"there, no load), V = {r['energy']:.6g}, neutral along the free nodes (V is flat: not "
+        f"stable)"
+        + (f"; {held} at one pose (run.json real_search.free_regions)" if held else "")
+        + f"; {r['pieces']} boxes"
+        + ("" if r["witnessed"] else "; no pose of it seen: may be empty")
+    )
 
 
 def _plural(n: int, word: str) -> str:

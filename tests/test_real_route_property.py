@@ -116,3 +116,30 @@ def test_a_node_free_to_float_is_reported_as_a_region_and_the_search_finishes():
     for p in ref:
         assert np.abs(X - np.concatenate([p["X"], far])).max(axis=1).min() < 1e-7
     assert res.record["details"]["real_search"]["seconds"] < 60
+
+
+@pytest.mark.slow
+def test_the_floppy_prism_finishes_with_its_regions_and_rows_that_are_critical():
+    """prism_saddle without the loads on A and B: B (and A) can have every cable slack, a
+    region of equilibria of full dimension along them. The search finishes (it used to run
+    silent for 13 minutes and more), reports a region with B free that a pose of its own
+    witnesses, never calls the result a contradiction, and each isolated row is a critical
+    point of tensegrity_physics' piecewise statics (Lagrange residual below 1e-9)."""
+    fw = cb.Framework.from_toml(ROOT / "tests" / "fixtures" / "prism_floppy.toml")
+    res = cb.solve(fw, cache=False)
+    search = res.record["details"]["real_search"]
+    assert res.status in ("ok", "incomplete") and search["seconds"] < 300
+    assert any(r["free_nodes"] == ["B"] and r["witnessed"] for r in search["free_regions"])
+    s = 0.8660254037844386 * 1.03
+    statics = tp.Spatial(
+        {"a": (1.03, 0, 0), "b": (-0.515, s, 0), "c": (-0.515, -s, 0)}, ("A", "B", "C"),
+        (("a", "A", 1.31), ("b", "B", 1.31), ("c", "C", 1.31)),
+        (("diag_Ac", "A", "c", 1.42, 0.83), ("diag_Ab", "A", "b", 1.18, 0.97),
+         ("diag_Ba", "B", "a", 1.42, 0.83), ("diag_Cb", "C", "b", 1.42, 0.83),
+         ("top_AB", "A", "B", 0.93, 1.37), ("top_BC", "B", "C", 1.06, 1.37)),
+        loads=(("C", (0.0, 0.0, -0.19)),),
+    )  # fmt: skip
+    rows = res.physical
+    X = rows[[f"{n}.{c}" for n in "ABC" for c in "xyz"]].to_numpy(float)
+    _, residual, _, _ = tp.newton(statics, X, None, steps=0)
+    assert len(rows) >= 7 and residual.max() < 1e-9

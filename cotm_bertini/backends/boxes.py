@@ -500,7 +500,8 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, testing) -
             one = (verdict == 1) & flat
             if one.any():
                 at = cand[one]
-                x = _free_points(_sub(land, at), lo[at], hi[at], k_lo[one], k_hi[one], free[at])
+                x = _free_points(_sub(land, at), lo[at], hi[at], k_lo[one], k_hi[one], free[at],
+                                 _subset(slack, at))  # fmt: skip
                 pieces = (at, np.hstack([lo[at], hi[at], x, free[at]]))
     leaf = ~aside & (decided | ~smooth) if springs else np.zeros(len(lo), dtype=bool)
     rest = ~aside & ~decided & ~later
@@ -671,15 +672,15 @@ def _free(land, box: Interval, states) -> tuple[np.ndarray, dict]:
     return code, {c: m for c, m in slack.items() if m.any()}
 
 
-def _free_points(land, lo, hi, k_lo, k_hi, free, steps: int = 40) -> np.ndarray:
+def _free_points(land, lo, hi, k_lo, k_hi, free, slack, steps: int = 40) -> np.ndarray:
     """The critical point of the other angles each free box holds alone (Newton on them from
-    the middle of K n X), the free angles at the box's middle."""
+    the middle of K n X, the cables of `slack` slack), the free angles at the box's middle."""
     a, b = np.maximum(lo, k_lo), np.minimum(hi, k_hi)
     x = np.where(free, 0.5 * (lo + hi), 0.5 * (a + b))
     n = lo.shape[1]
     both = ~free[:, :, None] & ~free[:, None, :]
     for _ in range(steps):
-        g, h = point_derivatives(land, x)
+        g, h = land.derivatives(x, slack) if slack else point_derivatives(land, x)
         h = np.where(both, h, np.eye(n))
         new = x - np.nan_to_num(_newton_steps(h, np.where(free, 0.0, g)))
         inside = ((new >= a) & (new <= b)).all(axis=1)

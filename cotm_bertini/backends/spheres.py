@@ -378,11 +378,12 @@ class SphereFramework:
         pad = 4 * np.finfo(float).eps * (np.abs(lo) + np.abs(hi)) + 1e-300
         return Interval(lo - pad, hi + pad)
 
-    def derivatives(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def derivatives(self, x: np.ndarray, slack: dict | None = None) -> tuple:
         """grad V and its Hessian at points (R, n chart angles) in double precision (each
-        point's Hessian that of its taut set: a slack cable adds nothing)."""
+        point's Hessian that of its taut set: a slack cable adds nothing; the cables of
+        `slack`, name -> (R,) bool, taken slack where it says so)."""
         count = len(x)
-        g, H, _, dirs, _ = self._numeric(x)
+        g, H, _, dirs, _ = self._numeric(x, slack)
         J = np.stack([np.stack(row, axis=1) for row in self.jacobian(dirs, count)], axis=1)
         hess = np.einsum("nia,nij,njb->nab", J, H, J)
         for i, v in enumerate(self.nodes):
@@ -391,7 +392,7 @@ class SphereFramework:
                 hess[:, 2 * i + p, 2 * i + q] += self.length[v] * _dot(dirs[i][key], G)
         return np.einsum("nia,ni->na", J, g), hess
 
-    def _numeric(self, x: np.ndarray) -> tuple:
+    def _numeric(self, x: np.ndarray, slack: dict | None = None) -> tuple:
         """At points (R, n chart angles): grad V and its Hessian in node coordinates (each
         point's taut set), the node coordinates, the directions with their derivatives, and
         each spring's and cable's length."""
@@ -412,6 +413,8 @@ class SphereFramework:
                 M = np.einsum("n,nc,ne->nce", link.k * link.L0 / d**3, r, r)
                 if link.cable:
                     taut = d > link.L0
+                    if slack and link.name in slack:
+                        taut &= ~slack[link.name]
                     w, M = np.where(taut, w, 0.0), M * taut[:, None, None]
             M = M + w[:, None, None] * np.eye(3)  # the Hessian of the link's energy in r
             D = self.stencil[i]

@@ -67,7 +67,7 @@ class BoxLandscape(Protocol):
 
     # Optional: `domain(start) -> (lo, hi)`, the boxes that cover the configuration space
     # (charts of a sphere, say); without it the torus grid of `initial_boxes`.
-    # Optional: `free(box, states) -> (code (B, n) int, slack)`: FREE for the angles along
+    # Optional: `free(box, states, grad) -> (code (B, n) int, slack)`: FREE for the angles along
     # which grad V is 0 at every critical point in the box whatever they are (a node with its
     # every element slack and no load), with the cables to take as slack there (`slack`, name
     # -> (B,) bool, for enclose(box, slack) and the states hessian reads); EDGE where that may
@@ -461,7 +461,7 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, testing) -
     rows = np.arange(len(lo))
     dd, grad, states = land.enclose(box)
     # Along free angles grad V is 0 whatever they are: the box is searched in the others.
-    code, slack = _free(land, box, states)
+    code, slack = _free(land, box, states, grad)
     if slack:  # those boxes' critical points have these cables slack: V as it is there
         dd, grad, states = land.enclose(box, slack=slack)
     free = code == FREE
@@ -663,12 +663,12 @@ def _roots(land: BoxLandscape, lo, hi, k_lo, k_hi, steps: int = 40) -> tuple:
     return x, np.hstack([lo, hi]), good
 
 
-def _free(land, box: Interval, states) -> tuple[np.ndarray, dict]:
+def _free(land, box: Interval, states, grad: Interval) -> tuple[np.ndarray, dict]:
     """(code (B, n), slack) of landscape.free over each box (none free without it)."""
     rule = getattr(land, "free", None)
     if rule is None:
         return np.zeros(box.lo.shape, dtype=np.int8), {}
-    code, slack = rule(box, states)
+    code, slack = rule(box, states, grad)
     return code, {c: m for c, m in slack.items() if m.any()}
 
 

@@ -148,64 +148,75 @@ class SphereFramework:
         hi = np.array([[v for i in row for v in (parts[i][0][1], parts[i][1][1])] for row in idx])
         return lo, hi
 
-    def free(self, box: Interval, states: dict) -> tuple[np.ndarray, dict]:
+    def free(self, box: Interval, states: dict, grad: Interval) -> tuple[np.ndarray, dict]:
         """(code (B, n), slack) over boxes. A node with no load on what hangs from it feels the
         rest only through the cables joining the two; where each is slack over a box, grad V
         is 0 along the node's two angles whatever they are (code FREE: V is flat there). Where
-        some may be taut (none is certainly), a critical point in the box has them all slack,
-        or a taut one balanced by the others (sum w_c v_c = 0, w_c >= 0, v_c the pull of
-        cable c in the node's angles): where one direction has every such v_c on its positive
-        side the second cannot be, so every critical point has the node's cables slack, and
-        the box is FREE with them taken as slack (`slack`: name -> (B,) bool). Else EDGE.
-        Where one is certainly taut and the pulls so lie, no critical point is in the box at
-        all (code NONE): near the edge of a free region the pulls are weak, and the enclosure
-        of grad V alone would exclude such boxes only when they are very small."""
+        some may be taut, a critical point in the box has them all slack, or a taut one
+        balanced by the others (sum w_c v_c = 0, w_c >= 0, v_c the pull of cable c in the
+        node's angles); where one direction has every such v_c on its positive side the
+        second cannot be: with none certainly taut every critical point has the node's cables
+        slack, and the box is FREE with them taken as slack (`slack`: name -> (B,) bool);
+        with one certainly taut no critical point is in the box (code NONE: near the edge of
+        a free region the pulls are weak, and the enclosure of grad V alone would exclude such
+        boxes only when they are very small). Else EDGE where none is certainly taut. The test
+        runs where the node's components of `grad` (the box's enclosure) both hold 0."""
         count = box.lo.shape[0]
         code, slack = np.zeros((count, self.n), dtype=np.int8), {}
-        for i, cables in self.floating().items():
+        floating = self.floating()
+        marks, todo = {}, {}
+        for i, cables in floating.items():
             certain, loose = np.ones(count, dtype=bool), np.ones(count, dtype=bool)
             for c in cables:
                 certain &= states[c] == SLACK
                 loose &= states[c] != TAUT
-            rows = np.flatnonzero(~certain)
+            near = grad[:, 2 * i].contains_zero() & grad[:, 2 * i + 1].contains_zero()
+            marks[i], todo[i] = (certain, loose), np.flatnonzero(~certain & near)
+        rows = np.unique(np.concatenate([np.zeros(0, dtype=np.int64), *todo.values()]))
+        if len(rows):
+            last = getattr(self, "_last", (None,))
+            if last[0] is box.lo:  # the box `enclose` just saw: its positions and directions
+                positions = [_rows_of(p, rows) for p in last[1]]
+                dirs = [{k: [_rows_of(c, rows) for c in v] for k, v in d.items()} for d in last[2]]
+            else:
+                positions, dirs = self.kinematics(box[rows], second=False)
+            first = ball_module(self.full).first_order(self.pose(positions, len(rows)), self.P)
+        for i, cables in floating.items():
+            (certain, loose), at = marks[i], todo[i]
             none = np.zeros(count, dtype=bool)
-            if len(rows):
-                sub = {c: states[c][rows] for c in cables}
-                one_side = rows[self._unbalanced(box[rows], i, cables, sub)]
+            if len(at):
+                loc = np.searchsorted(rows, at)
+                one_side = at[self._unbalanced(first, dirs, loc, i, cables, states, at)]
                 none[one_side[~loose[one_side]]] = True
                 certain[one_side[loose[one_side]]] = True
             code[:, 2 * i : 2 * i + 2] = np.where(
-                none | (code[:, 2 * i] == NONE), NONE,
-                np.where(certain, FREE, np.where(loose, EDGE, 0)))[:, None]  # fmt: skip
+                none, NONE, np.where(certain, FREE, np.where(loose, EDGE, 0)))[:, None]  # fmt: skip
             if certain.any():
                 for c in cables:
                     slack[c] = slack.get(c, np.zeros(count, dtype=bool)) | certain
         return code, slack
 
-    def _unbalanced(self, box: Interval, i: int, cables: list[str], states: dict) -> np.ndarray:
-        """Per box: whether the pulls in node i's angles of its cables that may be taut lie
-        strictly on one side of a line (no taut balance: `free`)."""
-        # (Each such cable's pull is the gradient of |r|^2 / 2 in the node's angles; its force
-        # adds w >= 0 times it, w > 0 where it is taut.)
-        count = box.lo.shape[0]
-        positions, dirs = self.kinematics(box, second=False)
-        first = ball_module(self.full).first_order(self.pose(positions, count), self.P)
-        m, per, v = len(positions), 3 + 3 * len(positions), self.nodes[i]
+    def _unbalanced(self, first, dirs, loc, i: int, cables, states: dict, at) -> np.ndarray:
+        """Per box `at` (rows `loc` of `first` and `dirs`, the generated first_order and the
+        directions there): whether the pulls in node i's angles of its cables that may be
+        taut lie strictly on one side of a line (no taut balance: `free`). A crossing cable's
+        pull is the gradient of |r|^2 / 2 there: +-r (its end below node i) along u_a, u_b."""
+        per, v = 3 + 3 * len(self.coords), self.nodes[i]
+        below = set(self.subtree(v))
         pulls = []
         for k, x in enumerate(self.links):
-            if x.name not in cables or not (states[x.name] != SLACK).any():
+            on = states[x.name][at] != SLACK if x.name in cables else None
+            if on is None or not on.any():
                 continue
-            r, dr = first[k * per : k * per + 3], first[k * per + 3 : (k + 1) * per]
-            g = [interval_sum([Interval(np.zeros(count)) + 0.0]
-                              + [Interval.of(r[c]) * dr[c * m + j] for c in range(3)
-                                 if not _zero(dr[c * m + j])]) for j in range(m)]  # fmt: skip
-            G = self.pull(g, v)
-            pull = [self.length[v] * _dot(dirs[i][key], G) for key in ("ua", "ub")]
-            pulls.append((states[x.name] != SLACK, pull))
+            sign = next(sg for j, sg in self.ends[k] if j in below)
+            r = [_rows_of(first[k * per + c], loc) for c in range(3)]
+            u = {key: [_rows_of(dirs[i][key][c], loc) for c in range(3)] for key in ("ua", "ub")}
+            pull = [_dot(u[key], r) * (sign * self.length[v]) for key in ("ua", "ub")]
+            pulls.append((on, pull))
         if not pulls:
-            return np.ones(count, dtype=bool)
+            return np.ones(len(loc), dtype=bool)
         e = sum(np.where(on[:, None], np.stack([p[0].mid, p[1].mid], 1), 0.0) for on, p in pulls)
-        ok = np.ones(count, dtype=bool)
+        ok = np.ones(len(loc), dtype=bool)
         for on, p in pulls:
             side = p[0] * e[:, 0] + p[1] * e[:, 1]
             ok &= ~on | (side.lo > 0)
@@ -295,6 +306,7 @@ class SphereFramework:
         the cables of `slack` taken slack where it says so."""
         count = box.lo.shape[0]
         positions, dirs = self.kinematics(box, second=False)
+        self._last = (box.lo, positions, dirs)  # for `free`, called next on the same box
         g, dds, states = self.node_gradient(positions, count, slack)
         grad = []
         for i, v in enumerate(self.nodes):
@@ -556,6 +568,15 @@ def _link_block(x, r: Interval, state=None) -> Interval:
             np.where(slack, 0.0, np.where(either, np.maximum(T.hi, 0.0), T.hi)),
         )
     return T + Interval(w.lo[:, None, None] * eye, w.hi[:, None, None] * eye)
+
+
+def _rows_of(v, loc: np.ndarray) -> Interval:
+    """Rows `loc` of a generated value over boxes (an Interval, or a constant for them all)."""
+    if isinstance(v, Interval):
+        return (
+            v[loc] if np.ndim(v.lo) else Interval(np.full(len(loc), v.lo), np.full(len(loc), v.hi))
+        )
+    return Interval(np.full(len(loc), float(v)))
 
 
 def _slack_of(states: dict) -> dict:

@@ -23,6 +23,7 @@ ENV_SECONDS = "COTM_PROGRESS_SECONDS"  # seconds between two lines when stderr i
 ENV_DELAY = "COTM_PROGRESS_DELAY"  # seconds a stage nobody announced runs before it is shown
 LINE_SECONDS = 5.0
 DELAY = 5.0
+WINDOW = 10.0  # seconds at least: a fraction's time left is at the rate of its last window
 OFF = ("0", "no", "off", "false")
 
 
@@ -118,6 +119,7 @@ class Progress:
         self.done = self.initial = initial
         self.note = ""
         self.start = self._last = time.perf_counter()
+        self._history = [(self.start, float(initial))]  # (time, done): a fraction's window
         self.active = force or enabled()
         self._shown = self._ended = False
         self._lock = threading.Lock()
@@ -163,16 +165,34 @@ class Progress:
 
     @property
     def left(self) -> float | None:
-        """Seconds left at the measured rate (None when no rate or no total is known)."""
-        rate = self.rate
-        if rate is None or self.total is None:
+        """Seconds left at the measured rate (None when no rate or no total is known). For a
+        fraction (a search's share of volume decided, whose pace falls as it goes) the rate is
+        that of the last window (a third of the time so far, WINDOW seconds at least): None
+        before a window has passed or when the window decided nothing."""
+        if self.total is None:
             return None
-        return max(0.0, rate * (self.total - self.done))
+        if isinstance(self.total, float):
+            return self._window_left()
+        rate = self.rate
+        return None if rate is None else max(0.0, rate * (self.total - self.done))
+
+    def _window_left(self) -> float | None:
+        now = time.perf_counter()
+        span = max(WINDOW, (now - self.start) / 3)
+        if now - self.start < span:
+            return None
+        t0, d0 = next((t, d) for t, d in reversed(self._history) if now - t >= span)
+        if self.done <= d0:
+            return None
+        return max(0.0, (now - t0) / (self.done - d0) * (self.total - self.done))
 
     def update(self, n: float = 1, note: str | None = None) -> None:
         """`n` more units done; `note`: what to show after the count (e.g. paths lost)."""
         with self._lock:
             self.done += n
+            now = time.perf_counter()
+            if now - self._history[-1][0] >= 0.5:
+                self._history.append((now, self.done))
             if note is not None:
                 self.note = note
             if self._bar is not None:
@@ -237,8 +257,11 @@ class Progress:
         if self.rate is not None and not isinstance(self.total, float):
             parts.append(f"{duration(self.rate)} a {_one(self.unit)}")
         parts.append(f"{duration(self.elapsed)} so far")
-        if self.left is not None:
-            parts.append(f"about {duration(self.left)} left")
+        left = self.left
+        if left is not None:
+            parts.append(f"about {duration(left)} left")
+        elif isinstance(self.total, float):
+            parts.append("time left not known yet")
         return f"{text}; {', '.join(parts)}"
 
     def _print(self, final: bool) -> None:

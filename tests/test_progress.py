@@ -233,3 +233,28 @@ def test_fold_curves_say_each_stage(monkeypatch, capsys):
     assert f"{head}: tracing curves from seeds: {info['seeds']}/{info['seeds']} seeds" in err
     assert re.search(rf"{re.escape(head)}: classifying the points: (\d+)/\1 chunks", err)
     assert re.search(rf"{re.escape(head)}: equilibria .*: 1/9 lines; [\d.]+ s a line", err)
+
+
+def test_a_fraction_s_time_left_is_at_its_recent_rate_and_unknown_when_it_stalls(monkeypatch):
+    """A search's share decided races to 90% and then crawls: the time left is that of the
+    last window's pace (not the 22 s the first minute's average kept saying for six minutes),
+    not known before a window has passed, and not known while nothing is decided."""
+    from cotm_bertini import progress
+
+    clock = [0.0]
+    monkeypatch.setattr(progress.time, "perf_counter", lambda: clock[0])
+    p = progress.Progress("search", 1.0, "of the poses decided", delay=0.0, force=True)
+    for t in range(1, 11):  # 9% a second for 10 s
+        clock[0] = float(t)
+        p.set(0.09 * t)
+        if t == 9:
+            assert p.left is None  # one window (10 s) has not passed since the start
+    for t in range(11, 61):  # then 0.01% a second for 50 s
+        clock[0] = float(t)
+        p.set(0.9 + 0.0001 * (t - 10))
+    # the last window (20 s, a third of 60) decided 0.002: 0.095 left takes 950 s at that pace
+    assert p.left == pytest.approx(0.095 / 0.002 * 20, rel=1e-6)
+    assert p.left > 100 * (p.elapsed / p.done) * (1 - p.done)  # the average would say ~6 s
+    clock[0] = 100.0  # 40 s with nothing decided
+    assert p.left is None and "time left not known yet" in p.line()
+    p.close()

@@ -103,11 +103,13 @@ def test_5b_every_exit_code_of_a_solve_has_its_status_line():
         ("ok", "rows proved", 0),
         ("ok", "undecided", 5),
         ("ok", "contradiction", 4),
+        ("contradiction", None, 4),
     ]
     for status, cert, code in cases:
         got = _exit_code(status, None if cert is None else SimpleNamespace(status=cert))
         assert got == code, (status, cert)
-    assert _status_line(4).startswith("status contradiction (exit 4): the certificate")
+    assert _status_line(4).startswith("status contradiction (exit 4): a proof and an "
+                                      "independent check disagree")  # fmt: skip
     assert _status_line(5).startswith("status incomplete (exit 5): a completeness check failed")
 
 

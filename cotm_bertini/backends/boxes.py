@@ -491,26 +491,12 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, testing) -
         later[cand[~testing[cand]]] = True
         cand = cand[testing[cand]]
         if len(cand):
-            verdict, k_lo, k_hi = krawczyk(_sub(land, cand), lo[cand], hi[cand],
-                                           _subset(states, cand), free[cand],
-                                           _subset(slack, cand))  # fmt: skip
+            verdict, found, pieces, (at, a, b) = _tested(land, lo, hi, cand, states, free, slack)
             decided[cand[verdict != 0]] = True
-            at, a, b = _contract(lo[cand], hi[cand], k_lo, k_hi, free[cand], verdict)
             if len(at):  # every root in X lies in K(X): X n K(X) is searched instead of X
                 shrunk[cand[at]] = True
                 new_lo, new_hi = lo.copy(), hi.copy()
                 new_lo[cand[at]], new_hi[cand[at]] = a, b
-            flat = free[cand].any(axis=1)
-            one = (verdict == 1) & ~flat
-            if one.any():
-                at = cand[one]
-                found = (at, *_roots(_sub(land, at), lo[at], hi[at], k_lo[one], k_hi[one]))
-            one = (verdict == 1) & flat
-            if one.any():
-                at = cand[one]
-                x = _free_points(_sub(land, at), lo[at], hi[at], k_lo[one], k_hi[one], free[at],
-                                 _subset(slack, at))  # fmt: skip
-                pieces = (at, np.hstack([lo[at], hi[at], x, free[at]]))
     leaf = ~aside & (decided | ~smooth) if springs else np.zeros(len(lo), dtype=bool)
     rest = ~aside & ~decided & ~later & ~shrunk
     small = rest & ((width <= floor) | edge)
@@ -541,6 +527,28 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, testing) -
         np.vstack([once[1], twice[1]])), np.concatenate([once[2], twice[2]]),
         rows[later], (lo[later], hi[later]), *pieces, rows[small & edge],
     )  # fmt: skip
+
+
+def _tested(land, lo, hi, cand, states, free, slack) -> tuple:
+    """The Krawczyk test of the batch's boxes `cand`: (verdict, the roots found as _roots
+    gives them, the free pieces (rows, lo hi point mask), the contractions (_contract))."""
+    verdict, k_lo, k_hi = krawczyk(_sub(land, cand), lo[cand], hi[cand], _subset(states, cand),
+                                   free[cand], _subset(slack, cand))  # fmt: skip
+    n = lo.shape[1]
+    found = (cand[:0], np.zeros((0, n)), np.zeros((0, 2 * n)), np.zeros(0, dtype=bool))
+    pieces = (cand[:0], np.zeros((0, 4 * n)))
+    flat = free[cand].any(axis=1)
+    one = (verdict == 1) & ~flat
+    if one.any():
+        at = cand[one]
+        found = (at, *_roots(_sub(land, at), lo[at], hi[at], k_lo[one], k_hi[one]))
+    one = (verdict == 1) & flat
+    if one.any():
+        at = cand[one]
+        x = _free_points(_sub(land, at), lo[at], hi[at], k_lo[one], k_hi[one], free[at],
+                         _subset(slack, at))  # fmt: skip
+        pieces = (at, np.hstack([lo[at], hi[at], x, free[at]]))
+    return verdict, found, pieces, _contract(lo[cand], hi[cand], k_lo, k_hi, free[cand], verdict)
 
 
 def _contract(lo, hi, k_lo, k_hi, free, verdict) -> tuple:

@@ -108,6 +108,7 @@ def _checks(morse: dict, counts: dict, generic: list[str], proved: bool = False)
     (`generic`: why its generic set is incomplete, if it is), or a contradiction (`proved`: a
     real search proved the rows complete, and the Morse count says otherwise)."""
     warnings = list(generic)
+    proved = proved and not morse["degenerate"]  # a row without an index: no judgement
     if not morse["ok"]:
         total = morse["euler_characteristic"]
         parts = [f"#min - #saddle + #max (+ zero-length maxima) = {total} != 0 on the torus"] * (
@@ -432,12 +433,11 @@ def _solve_real(
     fw, settings: Settings, tolerances: Tolerances, t: Timings, ready=None, found=None
 ) -> PointSolution:
     """Every real equilibrium of a framework on a circle, torus or product of spheres, by the
-    branch and bound of backends.boxes over its configuration space (backends.real_route,
-    backends.spheres), classified as the complex route's
-    endpoints are; the search's proof (or what it left undecided) is the completeness check.
-    Boxes left undecided are searched for continua of equilibria (where V is constant along a
-    curve no box can be decided), traced and counted apart as on the complex route. `ready`
-    and `found`: the landscape (_real_landscape) and its search, where already made."""
+    branch and bound of backends.boxes over its configuration space, classified as the complex
+    route's endpoints are; the search's proof (or what it left undecided) is the completeness
+    check. Boxes left undecided are searched for continua of equilibria, traced and counted
+    apart as on the complex route; regions where a node floats are reported apart. `ready` and
+    `found`: the landscape (_real_landscape) and its search, where already made."""
     from .analysis.framework_checks import completeness, framework_counts, order_rows
     from .analysis.framework_continua import absorb, continuum_record, find_continua
     from .backends.box_shares import split_search
@@ -489,10 +489,12 @@ def _solve_real(
         )
         warnings = tuple(w for w in warnings if not w.startswith(failure))
         status, failure = (STATUS_INCOMPLETE if warnings else STATUS_OK), None
-    if failure and not search_info["warnings"]:
+    if failure and not search_info["warnings"] and not checks["morse"]["degenerate"]:
         # The search proved its rows are every critical point; the Morse count, which shares
         # none of its code, says they are not: one of the two is wrong, and no later check
         # can tell which. That is a bug to report, never a set that "may" be incomplete.
+        # (A row too near degenerate to have an index, at a cable switch say, leaves the
+        # count unable to judge: that stays incomplete.)
         status = STATUS_CONTRADICTION
         warnings = (f"contradiction: the real search proved its {len(found.roots)} critical "
                     f"points are all there are, yet {failure}: a bug (please report it with "

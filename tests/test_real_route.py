@@ -497,22 +497,3 @@ def test_a_seed_lines_branches_are_traced_once_for_a_taut_sets_curve_systems():
     other = curve_system(fw, one, "x", "y", "band_p")
     ts = np.linspace(0.0, 1.0, 3)
     assert branch_key(other, specs[0], ts, []) != branch_key(switch, specs[0], ts, [])
-
-
-def test_a_contraction_that_cuts_a_root_out_is_caught_by_the_morse_count(monkeypatch):
-    """Sabotage: every box the Krawczyk test leaves undecided is 'contracted' to its lower half
-    along its widest side, whatever K(X) says; roots in the upper halves are lost, and the Morse
-    count, which shares no code with the search, says the proof contradicts it."""
-    from cotm_bertini.backends import boxes
-
-    def cut(lo, hi, k_lo, k_hi, free, verdict):
-        at = np.flatnonzero(verdict == 0)
-        a, b = lo[at].copy(), hi[at].copy()
-        j = np.argmax(b - a, axis=1)
-        b[np.arange(len(at)), j] = 0.5 * (a[np.arange(len(at)), j] + b[np.arange(len(at)), j])
-        return at, a, b
-
-    monkeypatch.setattr(boxes, "_contract", cut)
-    res = cb.solve(cb.Framework.from_toml(XMODULE), route="real", cache=False)
-    assert len(res.physical) < 12
-    assert res.status == "contradiction" and res.warnings[0].startswith("contradiction:")

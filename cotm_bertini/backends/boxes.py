@@ -48,7 +48,6 @@ KRAWCZYK_BATCH = 1024  # boxes for the Krawczyk test wait until this many are pe
 # landscape.free's codes: an angle V is flat along, or may be, or no critical point in the box
 FREE, EDGE, NONE = 2, 1, -1
 EDGE_WIDTH = 0.05  # radians: a box at the edge of a free region this small is left undecided
-CONTRACT = 0.7  # a box whose X n K(X) is at most this of its widest side is shrunk, not split
 
 
 class BoxLandscape(Protocol):
@@ -482,8 +481,6 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, testing) -
     n = lo.shape[1]
     found = (rows[:0], np.zeros((0, n)), np.zeros((0, 2 * n)), np.zeros(0, dtype=bool))
     pieces = (rows[:0], np.zeros((0, 4 * n)))
-    shrunk = np.zeros(len(lo), dtype=bool)
-    new_lo, new_hi = lo, hi
     if len(test):
         zero = grad[test].contains_zero().all(axis=1) & ~(code[test] == NONE).any(axis=1)
         decided[test[~zero]] = True
@@ -491,14 +488,10 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, testing) -
         later[cand[~testing[cand]]] = True
         cand = cand[testing[cand]]
         if len(cand):
-            verdict, found, pieces, (at, a, b) = _tested(land, lo, hi, cand, states, free, slack)
+            verdict, found, pieces = _tested(land, lo, hi, cand, states, free, slack)
             decided[cand[verdict != 0]] = True
-            if len(at):  # every root in X lies in K(X): X n K(X) is searched instead of X
-                shrunk[cand[at]] = True
-                new_lo, new_hi = lo.copy(), hi.copy()
-                new_lo[cand[at]], new_hi[cand[at]] = a, b
     leaf = ~aside & (decided | ~smooth) if springs else np.zeros(len(lo), dtype=bool)
-    rest = ~aside & ~decided & ~later & ~shrunk
+    rest = ~aside & ~decided & ~later
     small = rest & ((width <= floor) | edge)
     if small.any():  # a root in or next to the box: split on (Krawczyk wants small boxes there)
         at = np.flatnonzero(small)
@@ -517,8 +510,6 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, testing) -
     plain = rest & ~small & ~deep
     once = _split(lo[plain], hi[plain], rows[plain], free)
     twice = _split(*_split(lo[deep], hi[deep], rows[deep], free), free)
-    twice = tuple(np.concatenate([t, c]) for t, c in zip(
-        twice, (new_lo[shrunk], new_hi[shrunk], rows[shrunk]), strict=True))  # fmt: skip
     bound = lambda m: np.hstack([lo[m], hi[m], _spring_bound(dd.hi[m])[:, None]])  # noqa: E731
     low = np.sqrt(np.maximum(dd.lo[leaf].min(axis=1), 0.0)) if springs else np.zeros(0)
     return _Outcome(
@@ -531,7 +522,7 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, testing) -
 
 def _tested(land, lo, hi, cand, states, free, slack) -> tuple:
     """The Krawczyk test of the batch's boxes `cand`: (verdict, the roots found as _roots
-    gives them, the free pieces (rows, lo hi point mask), the contractions (_contract))."""
+    gives them, the free pieces (rows, lo hi point mask))."""
     verdict, k_lo, k_hi = krawczyk(_sub(land, cand), lo[cand], hi[cand], _subset(states, cand),
                                    free[cand], _subset(slack, cand))  # fmt: skip
     n = lo.shape[1]
@@ -548,19 +539,7 @@ def _tested(land, lo, hi, cand, states, free, slack) -> tuple:
         x = _free_points(_sub(land, at), lo[at], hi[at], k_lo[one], k_hi[one], free[at],
                          _subset(slack, at))  # fmt: skip
         pieces = (at, np.hstack([lo[at], hi[at], x, free[at]]))
-    return verdict, found, pieces, _contract(lo[cand], hi[cand], k_lo, k_hi, free[cand], verdict)
-
-
-def _contract(lo, hi, k_lo, k_hi, free, verdict) -> tuple:
-    """(rows, lo, hi) of the boxes the Krawczyk test left undecided whose X n K(X) is at most
-    CONTRACT of X along its widest side (free angles kept whole): that box instead of X."""
-    ok = (verdict == 0) & np.isfinite(k_lo).all(axis=1) & np.isfinite(k_hi).all(axis=1)
-    a = np.where(free, lo, np.maximum(lo, k_lo))
-    b = np.where(free, hi, np.minimum(hi, k_hi))
-    wide = np.where(free, 0.0, hi - lo).max(axis=1)
-    ok &= (b >= a).all(axis=1) & (np.where(free, 0.0, b - a).max(axis=1) <= CONTRACT * wide)
-    at = np.flatnonzero(ok)
-    return at, a[at], b[at]
+    return verdict, found, pieces
 
 
 def _spring_bound(dd_hi: np.ndarray) -> np.ndarray:

@@ -146,3 +146,33 @@ def test_the_floppy_prism_finishes_with_its_regions_and_rows_that_are_critical()
     X = rows[[f"{n}.{c}" for n in "ABC" for c in "xyz"]].to_numpy(float)
     _, residual, _, _ = tp.newton(statics, X, None, steps=0)
     assert len(rows) >= 7 and residual.max() < 1e-9
+
+
+def test_the_spheres_slope_matrix_is_the_gradient_s_derivative_and_encloses_it():
+    """The bug behind prism_saddle's false proof was a Hessian that was not the derivative of
+    the gradient (slack cables counted taut). At random poses of prism_saddle the point Hessian
+    equals central differences of the point gradient (computed from the force densities, not
+    from the Hessian's link blocks), and over random boxes the interval slope matrix holds the
+    point Hessians of the box."""
+    from cotm_bertini.backends.real_route import new_landscape
+    from cotm_bertini.model.intervals import Interval
+
+    land = new_landscape(cb.Framework.from_toml(ROOT / "tests" / "fixtures" / "prism_saddle.toml"))
+    rng = np.random.default_rng(7)
+    lo, hi = land.domain(0)
+    k = rng.integers(len(lo), size=200)
+    x = lo[k] + rng.random((200, land.n)) * (hi[k] - lo[k])
+    g, H = land.derivatives(x)
+    h = 1e-6
+    for j in range(land.n):
+        e = np.zeros(land.n)
+        e[j] = h
+        fd = (land.derivatives(x + e)[0] - land.derivatives(x - e)[0]) / (2 * h)
+        assert np.allclose(fd, H[:, :, j], atol=1e-5, rtol=1e-5)
+    for w in (1e-1, 1e-2, 1e-4):
+        box = Interval(x - w, x + w)
+        _, _, states = land.enclose(box)
+        S = land.hessian(box, states)
+        pts = x + w * (2 * rng.random(x.shape) - 1)
+        _, Hp = land.derivatives(pts)
+        assert ((S.lo <= Hp) & (Hp <= S.hi)).all()

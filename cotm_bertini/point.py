@@ -635,12 +635,12 @@ def real_search_info(found, length_unit: float, along: int = 0, morse_bott: bool
 def free_regions(land, found, unit: tuple[float, float]) -> list[dict]:
     """The search's free pieces grouped into regions of equilibria: the same nodes free and
     the others at the same pose (to 1e-8); each with its free and held nodes, the held ones'
-    coordinates (file units), V there (file units), its pieces, and whether one piece's middle
-    has every cable of the free nodes slack (a pose of the region seen: `witnessed`)."""
+    coordinates (file units), V there (file units), its pieces, and whether a sampled pose of
+    a piece has every cable of the free nodes slack (a pose of the region seen: `witnessed`)."""
     out: list[dict] = []
     if not len(found.free_boxes):
         return out
-    X, lengths = land.positions(found.free_points), land.cable_lengths(found.free_points)
+    X = land.positions(found.free_points)
     free_length = {x.name: x.L0 for x in land.links}
     floating = land.floating()
     for k, (mask, x) in enumerate(zip(found.free_masks, X, strict=True)):
@@ -650,8 +650,7 @@ def free_regions(land, found, unit: tuple[float, float]) -> list[dict]:
         v = land.energy(found.free_points[k : k + 1], cut)[0] * unit[1] * unit[0] ** 2
         held = [i for i in range(len(land.nodes)) if not mask[2 * i]]
         pose = np.concatenate([x[3 * i : 3 * i + 3] for i in held]) if held else np.zeros(0)
-        slack = _witness(land, found, k, cut, free_length) or all(
-            lengths[c][k] < free_length[c] for c in cut)  # fmt: skip
+        slack = _witness(land, found, k, cut, free_length)
         same = next((r for r in out if r["free_nodes"] == [land.nodes[i] for i in free]
                      and np.abs(r["_pose"] - pose).max(initial=0) < 1e-8), None)  # fmt: skip
         if same is None:
@@ -666,12 +665,12 @@ def free_regions(land, found, unit: tuple[float, float]) -> list[dict]:
 
 
 def _witness(land, found, k: int, cables: tuple[str, ...], L0: dict, tries: int = 64) -> bool:
-    """Whether some pose of free piece k (its free angles drawn over the box, the others at
-    its point) has every cable of `cables` slack: a pose of the region seen."""
+    """Whether some pose of free piece k (its point, or its free angles drawn over the box, the
+    others at its point) has every cable of `cables` slack: a pose of the region seen."""
     n = land.n
     box, x, mask = found.free_boxes[k], found.free_points[k], found.free_masks[k]
     u = np.random.default_rng(k).random((tries, n))
-    pts = np.where(mask, box[:n] + u * (box[n:] - box[:n]), x)
+    pts = np.vstack([x, np.where(mask, box[:n] + u * (box[n:] - box[:n]), x)])
     lengths = land.cable_lengths(pts)
     return bool(np.all([lengths[c] < L0[c] for c in cables], axis=0).any())
 

@@ -449,7 +449,7 @@ def _solve_real(
     land, sets, pruned = ready or _real_landscape(fw, t)
     with t.stage("solve"):
         if found is None:  # shared over local processes or a Dask cluster where asked
-            found = split_search(landscape, fw, SHORT, MIN_WIDTH, workers=settings.workers or 1,
+            found = split_search(landscape, fw, SHORT, MIN_WIDTH, workers=settings.workers,
                                  scheduler=settings.scheduler, max_seconds=settings.timeout,
                                  label=f"real search of {fw.name}")  # fmt: skip
         # Critical points the search could not prove: in boxes left undecided (a continuum
@@ -472,11 +472,14 @@ def _solve_real(
         continua = find_continua(fw, parts, unit, tolerances) if len(seeds) else []
         absorb(parts, continua)
         table = order_rows(fw, [p[0] for p in parts])
-        checks = completeness(fw, table, report, continua, near_cones=found.set_aside_boxes)
+        cones = cone_records(land, found, unit)
+        checks = completeness(fw, table, report, continua, near_cones=found.set_aside_boxes,
+                              cones=cones)  # fmt: skip
     morse_bott = all(c.index is not None for c in continua)
     search_info = real_search_info(found, unit[0], along_continua(land, found, continua),
                                    morse_bott, regions)  # fmt: skip
     search_info["found_by_newton"] = len(seeds)
+    search_info["cone_points"] = cones
     if descents["starts"]:
         search_info["descents"] = {k: v for k, v in descents.items() if k != "points"}
     warnings = tuple(search_info["warnings"] + checks["warnings"])
@@ -630,6 +633,26 @@ def real_search_info(found, length_unit: float, along: int = 0, morse_bott: bool
         "warnings": warnings,
         "notes": notes,
     }
+
+
+def cone_records(land, found, unit: tuple[float, float]) -> list[dict]:
+    """The search's proved cone points (poses where a spring has zero length and V a critical
+    point in Clarke's sense: backends.cones), each with its spring, the body angles (deg), the
+    other elements' pull there against the spring's k L0 (file units), and its index and kind
+    (V falls across the cone set: a maximum in the plane of the spring's ends)."""
+    n = land.n
+    bodies = getattr(land, "bodies", None)
+    out = []
+    for row in found.cones:
+        x = land.links[land.free_springs[int(row[n])]]
+        angles = np.degrees(np.mod(row[:n], 2 * np.pi))
+        index = int(row[n + 2])
+        out.append({"spring": x.name, "pull": float(row[n + 1]) * unit[0] * unit[1],
+                    "push": float(x.k * x.L0) * unit[0] * unit[1], "index": index,
+                    "kind": "max" if index == n else "saddle",
+                    "angles_deg": dict(zip(bodies, angles.round(10).tolist(), strict=True))
+                    if bodies else angles.round(10).tolist()})  # fmt: skip
+    return out
 
 
 def free_regions(land, found, unit: tuple[float, float]) -> list[dict]:

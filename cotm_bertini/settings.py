@@ -72,8 +72,9 @@ class Settings:
     # every taut set: generic sets and parameter homotopy); None: the real route where it covers
     # the configuration space, else the complex one.
     route: str | None = None
-    # Local processes that share the real route's boxes (None or 1: the search in this
-    # process); not part of a result's key. A sweep or map splits its points instead.
+    # Local processes that share the real route's boxes (1: the search in this process; None:
+    # in this process for two seconds, then what it has not decided over one process a core);
+    # not part of a result's key. A sweep or map splits its points instead.
     workers: int | None = None
 
     def __new__(cls, *args: object, **values: object) -> Settings:

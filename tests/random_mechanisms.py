@@ -74,7 +74,8 @@ class Chain:
         for kind, _, at, anchor, k, L0 in self.elements:
             r = P[at] - np.asarray(anchor)
             d = np.linalg.norm(r, axis=1)
-            w = k * (1 - L0 / d)
+            with np.errstate(divide="ignore", invalid="ignore"):  # at a cone: Newton stops
+                w = k * (1 - L0 / d)
             if kind == "cable":
                 w = np.where(d > L0, w, 0.0)
             forces.append((at, -w[:, None] * r))
@@ -117,8 +118,10 @@ class Chain:
         return "\n".join(lines) + "\n"
 
 
-def planar_chain(seed: int, links: int = 2) -> Chain:
-    """A random chain of `links` links with three to five elements and a load on every end."""
+def planar_chain(seed: int, links: int = 2, collapse: bool = False) -> Chain:
+    """A random chain of `links` links with three to five elements and a load on every end;
+    with `collapse`, the springs' anchors lie within their points' reach (the springs may
+    shrink to zero length: V has cone sets)."""
     rng = np.random.default_rng(seed)
     lengths = tuple(rng.uniform(0.6, 1.2, links))
     mids = tuple((rng.uniform(0.2, 0.8) * L, rng.uniform(-0.3, 0.3)) for L in lengths)
@@ -129,9 +132,11 @@ def planar_chain(seed: int, links: int = 2) -> Chain:
         i = int(rng.integers(links)) if j else links - 1
         pt = str(rng.choice(["e", "m"]))
         far = reach[i] + rng.uniform(0.3, 1.5)  # beyond the point's reach: never length 0
+        if collapse and kind == "spring":
+            far = rng.uniform(0.1, 0.9) * reach[i]
         a = rng.uniform(0, 2 * np.pi)
         anchor = (far * np.cos(a), far * np.sin(a))
-        lo, hi = far - reach[i], far + reach[i]
+        lo, hi = max(far - reach[i], 0.05), far + reach[i]
         L0 = 0.0 if kind == "zfl" else rng.uniform(lo, 0.5 * (lo + hi) if kind == "spring" else hi)
         elements.append((kind, f"{kind}{j}", (i, pt), anchor, rng.uniform(0.5, 1.5), L0))
     loads = tuple((i, tuple(rng.normal(0, 0.3, 2))) for i in range(links))
@@ -158,6 +163,54 @@ def chain_critical_points(ch: Chain, starts: int = 3000, seed: int = 1) -> list[
                       "degenerate": bool(np.abs(ev).min() < 1e-7),
                       "energy": float(ch.energy(x[None])[0])})  # fmt: skip
     return found
+
+
+def chain_cone_points(ch: Chain, starts: int = 3000, seed: int = 1) -> list[dict]:
+    """The cone points of each spring with a free length: poses where its length is 0 and
+    A = J^T lambda with |lambda| < k L0 (A: grad V with that spring's -k L0 d term taken out,
+    i.e. the spring at zero free length; J: d(its vector)/dangle by central differences), by
+    Newton on (angles, lambda) from random starts. Dicts (spring, angles, pull, push, index:
+    2 plus the negative eigenvalues of the Lagrangian's Hessian along the cone set)."""
+    rng = np.random.default_rng(seed)
+    n, out = len(ch.lengths), []
+    for e, (kind, name, at, anchor, k, L0) in enumerate(ch.elements):
+        if kind != "spring" or L0 == 0:
+            continue
+        zfl = Chain(ch.lengths, ch.mids, ch.elements[:e] + (("zfl", name, at, anchor, k, 0.0),)
+                    + ch.elements[e + 1 :], ch.loads)  # fmt: skip
+        r = lambda th, at=at, anchor=anchor: ch.points(th)[at] - np.asarray(anchor)  # noqa: E731
+        jac = lambda th, r=r: np.stack([(r(th + 1e-6 * v) - r(th - 1e-6 * v)) / 2e-6  # noqa: E731
+                                        for v in np.eye(n)], axis=2)  # fmt: skip
+        lag = lambda y, zfl=zfl, r=r, jac=jac: np.hstack([  # noqa: E731
+            zfl.gradient(y[:, :n]) - np.einsum("bcj,bc->bj", jac(y[:, :n]), y[:, n:]),
+            r(y[:, :n])])  # fmt: skip
+        y = np.hstack([rng.uniform(0, 2 * np.pi, (starts, n)), rng.normal(0, k * L0, (starts, 2))])
+        for _ in range(40):
+            with np.errstate(all="ignore"):
+                D = np.stack([(lag(y + 1e-6 * v) - lag(y - 1e-6 * v)) / 2e-6 for v in np.eye(n + 2)], 2)
+            F = lag(y)
+            bad = ~(np.isfinite(D).all(axis=(1, 2)) & np.isfinite(F).all(axis=1))
+            D[bad], F[bad] = np.eye(n + 2), 0.0  # at another spring's cone: that start stops
+            step = np.einsum("bij,bj->bi", np.linalg.pinv(D), F)
+            y = y - np.nan_to_num(np.clip(step, -0.5, 0.5))
+        with np.errstate(all="ignore"):
+            good = np.abs(lag(y)).max(axis=1) < 1e-9
+        for x in y[good]:
+            x = x.copy()
+            x[:n] = np.mod(x[:n], 2 * np.pi)
+            pull = float(np.hypot(*x[n:]))
+            if pull >= k * L0 or any(
+                np.abs((x[:n] - p["angles"] + np.pi) % (2 * np.pi) - np.pi).max() < 1e-7
+                for p in out if p["spring"] == name):  # fmt: skip
+                continue
+            J = jac(x[None, :n])[0]
+            H = np.stack([(lag(x[None] + 1e-5 * v)[0, :n] - lag(x[None] - 1e-5 * v)[0, :n]) / 2e-5
+                          for v in np.eye(n + 2)[:n]], axis=1)  # fmt: skip
+            N = np.linalg.svd(J)[2][2:]
+            ev = np.linalg.eigvalsh(N @ (0.5 * (H + H.T)) @ N.T) if n > 2 else np.zeros(0)
+            out.append({"spring": name, "angles": x[:n], "pull": pull, "push": k * L0,
+                        "index": 2 + int((ev < 0).sum())})  # fmt: skip
+    return out
 
 
 # --- nodes hanging by bars (products of spheres) ----------------------------------------------

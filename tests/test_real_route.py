@@ -382,22 +382,27 @@ def test_route_real_is_refused_where_it_does_not_cover_the_space():
 
 
 @pytest.mark.parametrize("name", ["xmodule", "cotm"])
-def test_cone_points_from_the_search_equal_bertinis(name):
-    """The zero-length poses the Morse count needs, by Newton from the boxes the search set
-    aside, against Bertini's ab-initio solve of the same system."""
+def test_cone_points_proved_by_the_search_equal_bertinis(name):
+    """The zero-length poses the search proves critical (in Clarke's sense: the other
+    elements' pull there weaker than k L0) against Bertini's ab-initio solve of the zero-length
+    system and the pull computed there: the same poses, each a maximum (index 2)."""
     from cotm_bertini.analysis.framework_checks import cone_points
     from cotm_bertini.backends.boxes import MIN_WIDTH, SHORT, search
     from cotm_bertini.backends.real_route import TorusFramework
 
     fw = cb.Framework.from_toml(ROOT / "examples" / f"{name}.toml")
-    found = search(TorusFramework(fw), SHORT, MIN_WIDTH)
-    near = cone_points(fw, found.set_aside_boxes)
-    ref = cone_points(fw)
-    assert len(ref) == len(near) > 0
+    land = TorusFramework(fw)
+    found = search(land, SHORT, MIN_WIDTH)
+    assert found.set_aside == 0 and len(found.undecided) == 0
+    ref = [c for c in cone_points(fw) if c["is_max"]]
+    assert len(ref) == len(found.cones) > 0
+    trig = np.stack([np.cos(found.cones[:, :2]), np.sin(found.cones[:, :2])], axis=2)
     for c in ref:
-        gaps = [np.abs(np.array(c["pose"]) - np.array(d["pose"])).max() for d in near]
+        gaps = np.abs(trig.reshape(-1, 4) - np.array(c["pose"])).max(axis=1)
         k = int(np.argmin(gaps))
-        assert gaps[k] < 1e-9 and near[k]["is_max"] == c["is_max"]
+        assert gaps[k] < 1e-9
+        assert found.cones[k, 4] == 2  # index: a maximum
+        assert abs(found.cones[k, 3] - c["pull"]) < 1e-8 * max(1.0, c["push"])
 
 
 def test_unbounded_products_stay_sound():

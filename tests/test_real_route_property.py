@@ -176,3 +176,97 @@ def test_the_spheres_slope_matrix_is_the_gradient_s_derivative_and_encloses_it()
         pts = x + w * (2 * rng.random(x.shape) - 1)
         _, Hp = land.derivatives(pts)
         assert ((S.lo <= Hp) & (Hp <= S.hi)).all()
+
+
+# Chains whose springs can shrink to zero length (cone sets: curves on a 3-torus), seeds with
+# cone points among them; every seed in stress.
+COLLAPSING = [(s, 2 + s % 2) for s in (range(40) if FULL else (3, 5, 13))]
+
+
+@pytest.mark.parametrize(("seed", "links"), COLLAPSING)
+def test_a_chain_whose_springs_collapse_is_proved_with_its_cone_points(seed, links, tmp_path):
+    """Springs anchored within their points' reach: the search decides the boxes through
+    their cone sets. Its rows are the critical points Newton finds on the statics written
+    here, and its cone points those Newton finds on the Lagrange system of each spring at
+    zero length (|lambda| < k L0), with the same index; the Morse count holds."""
+    ch = rm.planar_chain(seed, links, collapse=True)
+    ref, ref_cones = rm.chain_critical_points(ch), rm.chain_cone_points(ch)
+    res = _solve(ch.toml(f"collapse_{seed}"), tmp_path, f"collapse_{seed}")
+    rows = res.physical
+    angles = np.radians(rows[[f"link{i + 1}.angle_deg" for i in range(links)]].to_numpy(float))
+    assert len(rows) == len(ref), (len(rows), len(ref))
+    for p in ref:
+        gap = np.abs((angles - p["angles"] + math.pi) % (2 * math.pi) - math.pi).max(axis=1)
+        assert gap.min() < 1e-7
+    cones = res.record["details"]["real_search"]["cone_points"]
+    assert len(cones) == len(ref_cones)
+    for c in ref_cones:
+        (hit,) = [d for d in cones if d["spring"] == c["spring"] and np.abs(
+            (np.radians(list(d["angles_deg"].values())) - c["angles"] + math.pi) % (2 * math.pi)
+            - math.pi).max() < 1e-7]  # fmt: skip
+        assert hit["index"] == c["index"]
+        assert math.isclose(hit["pull"], c["pull"], rel_tol=1e-6)
+    assert res.morse["applicable"] and res.morse["ok"]
+
+
+def test_the_cone_enclosures_hold_an_independent_statics(tmp_path):
+    """backends.cones reads A (grad V without the spring's -k L0 d), its slope matrix H, J and
+    d2r over boxes from the landscape: at random points of random boxes of a collapsing chain
+    they hold A written here (the chain with that spring at zero free length), central
+    differences of it and of the spring's vector (in the landscape's normalised units)."""
+    from cotm_bertini.backends.real_route import new_landscape
+    from cotm_bertini.model.framework.spec import units
+    from cotm_bertini.model.intervals import Interval
+
+    ch = rm.planar_chain(3, 3, collapse=True)
+    path = tmp_path / "cones.toml"
+    path.write_text(ch.toml("cones"))
+    fw = cb.Framework.from_toml(path)
+    land, (length, stiffness) = new_landscape(fw), units(fw)
+    energy = stiffness * length**2
+    rng, h, eye = np.random.default_rng(11), 1e-6, np.eye(3)
+    springs = [e for e in ch.elements if e[0] == "spring"]
+    for s, (_, name, at, anchor, _, _) in enumerate(springs):
+        assert land.links[land.free_springs[s]].name == name
+        zfl = rm.Chain(ch.lengths, ch.mids, tuple((("zfl", *e[1:5], 0.0) if e[1] == name else e)
+                                                  for e in ch.elements), ch.loads)  # fmt: skip
+        r = lambda th, at=at, anchor=anchor: ch.points(th)[at] - np.asarray(anchor)  # noqa: E731
+        for w in (0.3, 0.03, 1e-3):
+            x = rng.uniform(0, 2 * math.pi, (50, 3))
+            p = land.cone_parts(Interval(x - w, x + w), np.full(50, s))
+            y = x + w * (2 * rng.random(x.shape) - 1)
+            A = zfl.gradient(y) / energy
+            H = np.stack([zfl.gradient(y + h * e) - zfl.gradient(y - h * e) for e in eye], 2)
+            J = np.stack([r(y + h * e) - r(y - h * e) for e in eye], 2) / (2 * h * length)
+            J2 = np.stack([r(y + 1e-4 * e) - 2 * r(y) + r(y - 1e-4 * e) for e in eye], 2)
+            pairs = [(p.A, A, 1e-9), (p.H, H / (2 * h * energy), 1e-5), (p.J, J, 1e-6),
+                     (p.R2[:, :, range(3), range(3)], J2 / (1e-8 * length), 1e-5)]  # fmt: skip
+            for enc, v, tol in pairs:
+                assert ((enc.lo - tol <= v) & (v <= enc.hi + tol)).all(), (name, w, tol)
+
+
+def test_chain3_collapse_is_proved_with_its_cone_points_and_a_lost_one_is_a_contradiction(
+    monkeypatch,
+):
+    """examples/chain3.toml with two anchors within reach: proved, two cone points (spring s2,
+    index 2), the Morse count over rows and cone points 0. With the cone test sabotaged (a
+    proved cone point dropped as if none were there) the Morse count fails and the solve says
+    contradiction, not ok."""
+    from cotm_bertini.backends import boxes
+
+    fw = cb.Framework.from_toml(ROOT / "tests" / "fixtures" / "chain3_collapse.toml")
+    res = cb.solve(fw, route="real", cache=False)
+    assert res.status == "ok", res.warnings
+    cones = res.record["details"]["real_search"]["cone_points"]
+    assert [(c["spring"], c["index"]) for c in cones] == [("s2", 2), ("s2", 2)]
+    assert res.morse["applicable"] and res.morse["ok"] and res.morse["cone_points"] == 2
+    real = boxes.cone_test
+
+    def lossy(*args):
+        verdict, found, rows = real(*args)
+        empty = (found[0][:0], found[1][:0], found[2][:0])
+        return np.where(verdict == 1, -1, verdict), empty, rows[:0]
+
+    monkeypatch.setattr(boxes, "cone_test", lossy)
+    bad = cb.solve(fw, route="real", cache=False)
+    assert bad.status == "contradiction" and "Morse count" in bad.warnings[0]

@@ -90,10 +90,11 @@ def framework_counts(table: dict, report: dict, continua: list = ()) -> dict:
 
 
 def completeness(
-    fw: Framework, table: dict, report: dict, continua: list = (), near_cones=None
+    fw: Framework, table: dict, report: dict, continua: list = (), near_cones=None, cones=None
 ) -> dict:
     """Why no equilibrium is missing, or warnings saying why one may be: {"morse", "warnings"}
-    (`continua`: analysis.framework_continua's, each a term of the Morse sum)."""
+    (`continua`: analysis.framework_continua's, each a term of the Morse sum; `cones`: the
+    real search's proved cone points, each a term)."""
     warnings = []
     for label, info in report.items():
         if info.get("route") == "real":  # the search's own record says what it left
@@ -121,7 +122,7 @@ def completeness(
                 f"taut set {label}: {info['generic_singular']} singular endpoints at generic "
                 "parameters (a positive-dimensional solution set, not enumerated)"
             )
-    morse = morse_count(fw, table, continua, near_cones)
+    morse = morse_count(fw, table, continua, near_cones, cones)
     if morse.get("continuum_unknown"):
         warnings.append(f"{morse['reason']}: the Morse check is not applicable, so equilibria "
                         "may be missing")  # fmt: skip
@@ -171,10 +172,13 @@ def _collapsible(fw: Framework) -> list[str]:
             if slots[f"L0_{x.name}"] > 0 and length_bounds(fw, x.a, x.b)[0] <= 0]  # fmt: skip
 
 
-def morse_count(fw: Framework, table: dict, continua: list = (), near_cones=None) -> dict:
-    """sum (-1)^index over the physical equilibria (plus the cone maxima, plus each continuum's
-    term: docs/frameworks.md) must equal the Euler characteristic of the configuration space: 0
-    for a torus, 2^n for n spheres S2."""
+def morse_count(fw: Framework, table: dict, continua: list = (), near_cones=None,
+                cones: list | None = None) -> dict:  # fmt: skip
+    """sum (-1)^index over the physical equilibria (plus the cone points', plus each
+    continuum's term: docs/frameworks.md) must equal the Euler characteristic of the
+    configuration space: 0 for a torus, 2^n for n spheres S2. `cones`: the real search's cone
+    points (each with its index), where it proved them all; else, on a two-body torus, the
+    zero-length maxima solved here (cone_points)."""
     factors, why = configuration_space(fw)
     if not factors:
         return {"applicable": False, "ok": None, "reason": why or "nothing moves"}
@@ -185,7 +189,8 @@ def morse_count(fw: Framework, table: dict, continua: list = (), near_cones=None
             return {"applicable": False, "ok": None, "continuum_unknown": True, "reason": why}
     torus2 = factors == ["S1", "S1"] and fw.dim == 2
     collapsible = _collapsible(fw)
-    if collapsible and not torus2:
+    aside = near_cones is not None and len(near_cones) > 0
+    if collapsible and (cones is None or aside) and not torus2:
         return {"applicable": False, "ok": None, "reason": f"spring {collapsible[0]} may reach "
                 "zero length (a cone point of V the count cannot place)"}  # fmt: skip
     chi = int(np.prod([{"S1": 0, "SO3": 0, "S2": 2}[f] for f in factors]))
@@ -193,16 +198,22 @@ def morse_count(fw: Framework, table: dict, continua: list = (), near_cones=None
     kinds = np.asarray(table["kind"], dtype=object)[phys]
     index = np.asarray(table["index"], dtype=int)[phys]
     counts = {k: int((kinds == k).sum()) for k in ("min", "saddle", "max", "degenerate")}
-    maxima = sum(c["is_max"] for c in cone_points(fw, near_cones)) if torus2 else 0
+    if cones is not None and not aside:
+        cone_terms = [(-1) ** int(c["index"]) for c in cones]
+        maxima = sum(int(c["index"]) == len(factors) for c in cones)
+    else:
+        found = cone_points(fw, near_cones) if torus2 else []
+        maxima = sum(c["is_max"] for c in found)
+        cone_terms = [(-1) ** len(factors)] * maxima
     total = int(sum((-1) ** int(i) for i, k in zip(index, kinds, strict=True) if k != "degenerate"))
-    total += maxima * (-1) ** len(factors) + sum(t for t, _ in terms)
+    total += sum(cone_terms) + sum(t for t, _ in terms)
     # V is continuous on the compact configuration space: its global minimum is an equilibrium
     # (a cone point is a maximum), so a table without a minimum (isolated or a continuum of
     # minima) misses equilibria, whatever the alternating sum says (an empty table sums to 0).
     minima = sum(c.index == 0 for c in continua)
     ok = total == chi and counts["degenerate"] == 0 and counts["min"] + minima > 0
     return {"applicable": True, "manifold": " x ".join(factors), "expected": chi, **counts,
-            "zero_length_maxima": maxima, "continua": len(continua), "continua_minima": minima,
+            "zero_length_maxima": maxima, "cone_points": len(cone_terms), "continua": len(continua), "continua_minima": minima,
             "continua_term": sum(t for t, _ in terms), "euler_characteristic": total,
             "ok": ok}  # fmt: skip
 

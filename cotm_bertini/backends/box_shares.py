@@ -20,7 +20,7 @@ from ..errors import SolverError
 from ..model.intervals import Interval
 from ..progress import Progress, silenced
 from .boxes import BATCH, BoxLandscape, BoxSearch, domain, merged, search, spread
-from .pools import as_done
+from .pools import as_done, default_workers
 
 # A worker done early takes another share, and the progress moves a share at a time; but each
 # share walks its boxes down in as many batch steps as the whole search (about 1 ms of numpy's
@@ -32,6 +32,10 @@ SHARES_A_WORKER_LARGE = 16
 LARGE = 4  # dimensions from which a search counts as large
 BOXES_A_SHARE = 16  # breadth-first steps until there are this many boxes a share to deal
 SPREAD_STEPS = 8  # ... at most (a 1-D domain of 8 boxes: 16 a share after a few steps)
+# workers=None: the search runs in this process for this long first (most frameworks are
+# proved in well under a second, where starting processes would cost more than they save),
+# then the boxes it has not decided go to one process a core.
+PROBE_SECONDS = 2.0
 
 
 def split_search(
@@ -40,7 +44,7 @@ def split_search(
     short: float,
     min_width: float,
     *,
-    workers: int = 1,
+    workers: int | None = 1,
     scheduler: str | None = None,
     start: int = 8,
     max_boxes: int | None = None,
@@ -49,16 +53,32 @@ def split_search(
 ) -> BoxSearch:
     """boxes.search over the landscape `factory(source)`, its boxes shared among `workers`
     local processes or the workers of the Dask cluster at `scheduler` (a single worker: the
-    plain search in this process); the budgets hold for the whole search. `factory` and
-    `source` must pickle (a module's function and a frozen spec)."""
+    plain search in this process; None: in this process for PROBE_SECONDS, then what is left
+    over one process a core); the budgets hold for the whole search. `factory` and `source`
+    must pickle (a module's function and a frozen spec)."""
     land = factory(source)
     if scheduler is None and workers == 1:
         return search(land, short, min_width, start, max_boxes, max_seconds, label)
     t0 = time.perf_counter()
     first = domain(land, start)
-    _warm(land, first)
     volume = float(np.prod(first[1] - first[0], axis=1).sum())
     deadline = None if max_seconds is None else time.time() + max_seconds
+    heads = []
+    if workers is None and scheduler is not None:
+        workers = 1  # the cluster's workers take the shares
+    elif workers is None:
+        workers = default_workers()
+        probe = PROBE_SECONDS if max_seconds is None else min(PROBE_SECONDS, max_seconds)
+        if workers == 1:
+            return search(land, short, min_width, start, max_boxes, max_seconds, label)
+        found = search(land, short, min_width, start, max_boxes, probe, label, boxes=first)
+        if not found.budget_hit or probe == max_seconds or (max_boxes and found.boxes >= max_boxes):
+            return found  # proved, or stopped by the caller's own budget
+        first = (found.undecided[:, : land.n], found.undecided[:, land.n :])
+        heads.append(dataclasses.replace(found, undecided=found.undecided[:0], budget_hit="",
+                                         shares=0))  # fmt: skip
+        max_boxes = None if max_boxes is None else max_boxes - found.boxes
+    _warm(land, first)
     dealt: dict = {}  # what the breadth-first steps decided here, and the shares dealt
 
     def jobs(count: int) -> list[tuple]:
@@ -67,7 +87,7 @@ def split_search(
         (lo, hi), done = spread(land, first, short, min_width, shares * BOXES_A_SHARE,
                                 SPREAD_STEPS)  # fmt: skip
         dealt["head"] = dataclasses.replace(done, shares=0, volume=volume)
-        dealt["left"] = float(np.prod(hi - lo, axis=1).sum()) / volume
+        dealt["left"] = float(np.prod(hi - lo, axis=1).sum()) / volume  # of the whole domain
         dealt["shares"] = min(shares, len(lo))
         most = None if max_boxes is None else max(1, math.ceil(max_boxes / shares))
         step = dealt["shares"]
@@ -82,7 +102,7 @@ def split_search(
             boxes = dealt["head"].boxes + sum(p.boxes for p in parts.values())
             decided = 1.0 - dealt["left"] + sum(p.volume for p in parts.values()) / volume
             report.set(decided, note=f"{boxes:,} boxes, {len(parts)}/{dealt['shares']} shares")
-    found = [dealt["head"]] + [parts[k] for k in sorted(parts)]
+    found = heads + [dealt["head"]] + [parts[k] for k in sorted(parts)]
     _check_cover(label, dealt, parts, volume)
     return merged(found, volume, time.perf_counter() - t0)
 

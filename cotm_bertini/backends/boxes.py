@@ -5,9 +5,15 @@ A `BoxLandscape` encloses grad V and its Hessian (a valid slope matrix where V i
 smooth) over a batch of boxes, and the squared lengths of the springs with free lengths, where V
 is not smooth at length 0. Each box is
 
-- set aside, where such a spring is shorter than `short` over the whole box, or may be and the
-  box is no wider than `min_width` (the statement bounds the spring length over these boxes);
-- excluded, where the enclosure of some component of grad V misses 0;
+- tested at a spring's cone (backends.cones), where the landscape can (`cone_sets`) and the
+  spring's least length over the box is small against its spread there: excluded, or proved
+  to hold exactly one cone point (a critical point in Clarke's sense at zero length) and no
+  other critical point;
+- set aside, where a spring may be shorter than `short` and the box is no wider than
+  `min_width` undecided (without cone tests also where it is shorter over the whole box; the
+  statement bounds the spring length over these boxes);
+- excluded, where the enclosure of some component of grad V misses 0 (a spring's term is
+  enclosed through its cone too: finite where its length may be 0);
 - decided by the Krawczyk operator K(X) = m - Y g(m) + (I - Y H(X)) (X - m), Y the inverse of
   the Hessian's midpoint: K(X) inside the interior of X proves exactly one critical point in X
   (it lies in K(X)), K(X) disjoint from X proves none;
@@ -33,6 +39,8 @@ import numpy as np
 
 from ..model.intervals import Interval
 from ..progress import Progress
+from .cones import cone_test, near_cone
+from .krawczyk import krawczyk_step
 
 TWO_PI = 2 * math.pi
 OFFSET = -0.0123456789  # radians: the domain's lower corner (see the module docstring)
@@ -67,6 +75,8 @@ class BoxLandscape(Protocol):
 
     # Optional: `domain(start) -> (lo, hi)`, the boxes that cover the configuration space
     # (charts of a sphere, say); without it the torus grid of `initial_boxes`.
+    # Optional: `cone_sets` (True) and `cone_parts(box, spring) -> backends.cones.ConeParts`:
+    # boxes through a spring's zero-length poses are tested there (backends.cones).
     # Optional: `free(box, states, grad) -> (code (B, n) int, slack)`: FREE for the angles along
     # which grad V is 0 at every critical point in the box whatever they are (a node with its
     # every element slack and no load), with the cables to take as slack there (`slack`, name
@@ -115,6 +125,11 @@ class BoxSearch:
     free_points: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     free_masks: np.ndarray = field(default_factory=lambda: np.zeros((0, 0), dtype=bool))
     edge: int = 0  # of the undecided boxes, those at the edge of a free region (EDGE_WIDTH)
+    # Cone points (backends.cones): each a pose where a spring has zero length and V a critical
+    # point in Clarke's sense, proved alone in its box, no smooth one there. (C, 3n + 3): the
+    # angles, the spring (index among those with free lengths), |lambda| (the other elements'
+    # pull there, against k L0), the index, the box (lo, hi).
+    cones: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
 
     @property
     def undecided_share(self) -> float:
@@ -194,6 +209,7 @@ class _Member:
     budget: str = ""
     free: list = field(default_factory=list)  # (box, point, mask) rows of free pieces
     edge: int = 0
+    peaks: list = field(default_factory=list)  # cone points' rows (_Outcome.peaks)
 
     def stop(self, why: str) -> None:
         """Every box not yet decided listed as undecided (the next batch first), with why the
@@ -226,6 +242,7 @@ class _Member:
             self.boxes, clocks[0], self.shortest, self.budget, volume=volume,
             cpu_seconds=clocks[1], free_boxes=free[:, : 2 * n], free_points=free[:, 2 * n : 3 * n],
             free_masks=free[:, 3 * n :] > 0.5, edge=self.edge,
+            cones=_rows(self.peaks, 3 * n + 3),
         )  # fmt: skip
 
 
@@ -312,6 +329,7 @@ def merged(parts: list[BoxSearch], volume: float, seconds: float, apart: float =
         total("cpu_seconds"), shares, _rows([p.free_boxes for p in free], 2 * n),
         _rows([p.free_points for p in free], n),
         _rows([p.free_masks for p in free], n).astype(bool), total("edge"),
+        _rows([p.cones for p in parts if p.cones.size], 3 * n + 3),
     )  # fmt: skip
 
 
@@ -385,13 +403,15 @@ class _Outcome:
     free_rows: np.ndarray
     free: np.ndarray  # (f, 4n): lo, hi, the point, the free angles (1.0) of each free piece
     edge_rows: np.ndarray  # of the boxes left, those at the edge of a free region
+    peak_rows: np.ndarray
+    peaks: np.ndarray  # (c, 3n + 3): a cone point's angles, spring, |lambda|, index, lo, hi
 
     def parts(self, ends: np.ndarray) -> list[_Part]:
         """Each member's share of the outcome (the members' rows end at `ends`)."""
         if len(ends) == 1:
             return [_Part(int(ends[0]), self.aside, self.cone, self.leaf_short, self.roots,
                           self.root_boxes, self.root_good, self.left, self.split,
-                          self.later, self.free, len(self.edge_rows))]  # fmt: skip
+                          self.later, self.free, len(self.edge_rows), self.peaks)]  # fmt: skip
         cut = lambda rows, *arrays: [np.split(a, np.searchsorted(rows, ends[:-1]))  # noqa: E731
                                      for a in arrays]  # fmt: skip
         aside, cone = cut(self.aside_rows, self.aside)[0], cut(self.cone_rows, self.cone)[0]
@@ -399,6 +419,7 @@ class _Outcome:
         roots, boxes, good = cut(self.root_rows, self.roots, self.root_boxes, self.root_good)
         (left,) = cut(self.left_rows, self.left)
         (free,) = cut(self.free_rows, self.free)
+        (peaks,) = cut(self.peak_rows, self.peaks)
         edge = np.diff(np.searchsorted(self.edge_rows, ends), prepend=0)
         later = zip(*cut(self.later_rows, *self.later), strict=True)
         member = np.searchsorted(ends, self.parent, side="right")
@@ -408,7 +429,7 @@ class _Outcome:
         sizes = np.diff(ends, prepend=0)
         return [_Part(*v) for v in zip(sizes, aside, cone, short, roots, boxes, good, left,
                                         zip(lo, hi, strict=True), later, free, edge,
-                                        strict=True)]  # fmt: skip
+                                        peaks, strict=True)]  # fmt: skip
 
 
 @dataclass
@@ -427,6 +448,7 @@ class _Part:
     later: tuple[np.ndarray, np.ndarray]
     free: np.ndarray
     edge: int
+    peaks: np.ndarray
 
     def record(self, m: _Member, counted: bool) -> None:
         """Into the member's search: counts (the boxes unless `counted` when first taken),
@@ -448,6 +470,8 @@ class _Part:
         if len(self.free):
             m.free.append(self.free)
         m.edge += int(self.edge)
+        if len(self.peaks):
+            m.peaks.append(self.peaks)
         if len(self.split[0]):
             m.stack.append(self.split)
         if len(self.later[0]):
@@ -472,19 +496,35 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, testing) -
     aside, smooth = np.zeros(len(lo), dtype=bool), np.ones(len(lo), dtype=bool)
     floor = np.full(len(lo), float(min_width))
     springs = dd.lo.shape[1] > 0
+    cones = springs and getattr(land, "cone_sets", False)
+    near = np.zeros(len(lo), dtype=bool)
     if springs:
         smooth = ~(dd.lo <= short * short).any(axis=1)
-        aside = (dd.hi < short * short).any(axis=1) | (~smooth & (width <= min_width))
+        aside = ~smooth & (width <= min_width)
+        if not cones:  # no test through a cone: a box all shorter than `short` is set aside
+            aside |= (dd.hi < short * short).any(axis=1)
         floor = _floor(dd, min_width)
+    if cones:  # boxes through a spring's cone: tested there (backends.cones), not smoothly
+        near, which = near_cone(dd)
+        shortest = np.argmin(dd.lo, axis=1)  # a spring shorter than `short`: its cone rules
+        which = np.where(smooth, which, shortest)
+        near = (near | ~smooth) & ~aside & ~free.any(axis=1)
     decided, later = np.zeros(len(lo), dtype=bool), np.zeros(len(lo), dtype=bool)
-    test = np.flatnonzero(~aside & smooth)
+    test = np.flatnonzero(~aside & (smooth | cones))  # grad V enclosed through cones: finite
     n = lo.shape[1]
     found = (rows[:0], np.zeros((0, n)), np.zeros((0, 2 * n)), np.zeros(0, dtype=bool))
     pieces = (rows[:0], np.zeros((0, 4 * n)))
+    peaks = (rows[:0], np.zeros((0, 3 * n + 3)))
     if len(test):
         zero = grad[test].contains_zero().all(axis=1) & ~(code[test] == NONE).any(axis=1)
         decided[test[~zero]] = True
         cand = test[zero & (width[test] <= KRAWCZYK_WIDTH)]
+        if cones:
+            at = cand[near[cand]]
+            cand = cand[~near[cand] & (dd.lo[cand] > 0).all(axis=1)]
+            if len(at):
+                verdict, peaks = _cone_tested(land, lo, hi, at, which[at])
+                decided[at[verdict != 0]] = True
         later[cand[~testing[cand]]] = True
         cand = cand[testing[cand]]
         if len(cand):
@@ -506,7 +546,7 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, testing) -
         rest &= ~cone  # set aside: not split as well
     # Next to a cone point (a spring may be short) nothing is tested until the boxes are set
     # aside at the smallest width: two halvings at once there save a batch step each.
-    deep = rest & ~small & ~smooth & (width > 4 * min_width)
+    deep = rest & ~small & ~smooth & (width > 4 * min_width) & (not cones)
     plain = rest & ~small & ~deep
     once = _split(lo[plain], hi[plain], rows[plain], free)
     twice = _split(*_split(lo[deep], hi[deep], rows[deep], free), free)
@@ -516,7 +556,7 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, testing) -
         len(lo), rows[aside], bound(aside), rows[cone], bound(cone), rows[leaf], low, *found,
         rows[small], np.hstack([lo[small], hi[small]]), (np.vstack([once[0], twice[0]]),
         np.vstack([once[1], twice[1]])), np.concatenate([once[2], twice[2]]),
-        rows[later], (lo[later], hi[later]), *pieces, rows[small & edge],
+        rows[later], (lo[later], hi[later]), *pieces, rows[small & edge], *peaks,
     )  # fmt: skip
 
 
@@ -540,6 +580,16 @@ def _tested(land, lo, hi, cand, states, free, slack) -> tuple:
                          _subset(slack, at))  # fmt: skip
         pieces = (at, np.hstack([lo[at], hi[at], x, free[at]]))
     return verdict, found, pieces
+
+
+def _cone_tested(land, lo, hi, at, spring) -> tuple:
+    """backends.cones' test of the batch's boxes `at`, each at its spring's cone: (verdict, the
+    cone points as (rows, angles spring |lambda| index lo hi))."""
+    verdict, (x, lam, index), one = cone_test(_sub(land, at), lo[at], hi[at], spring)
+    rows = at[one]
+    pull = np.sqrt((lam * lam).sum(axis=1))
+    return verdict, (rows, np.hstack([x, spring[one][:, None], pull[:, None], index[:, None],
+                                      lo[rows], hi[rows]]))  # fmt: skip
 
 
 def _spring_bound(dd_hi: np.ndarray) -> np.ndarray:
@@ -625,30 +675,12 @@ def krawczyk(land: BoxLandscape, lo, hi, states, free=None, slack=None) -> tuple
     _, g_mid, _ = land.enclose(Interval(mid), slack=slack) if slack else land.enclose(Interval(mid))
     h = land.hessian(Interval(lo, hi), states)
     if free is None or not free.any():
-        free = np.zeros(lo.shape, dtype=bool)
-    else:
-        both = ~free[:, :, None] & ~free[:, None, :]
-        eye = np.broadcast_to(np.eye(n), both.shape)
-        h = Interval(np.where(both, h.lo, eye), np.where(both, h.hi, eye))
-        g_mid = Interval(np.where(free, 0.0, g_mid.lo), np.where(free, 0.0, g_mid.hi))
-    box = Interval(np.where(free, mid, lo), np.where(free, mid, hi))
-    h_mid = h.mid
-    ok = np.isfinite(h_mid).all(axis=(1, 2)) & g_mid.finite().all(axis=1)
-    ok &= np.abs(np.linalg.det(np.where(ok[:, None, None], h_mid, np.eye(n)))) > 1e-300
-    y = np.linalg.inv(np.where(ok[:, None, None], h_mid, np.eye(n)))
-    yg = (Interval(y) * Interval(g_mid.lo[:, None, :], g_mid.hi[:, None, :])).isum(axis=2)
-    yh = (Interval(y[:, :, :, None]) * Interval(h.lo[:, None, :, :], h.hi[:, None, :, :])).isum(
-        axis=2
-    )
-    spread = Interval(np.eye(n)) - yh  # (B, n, n)
-    dx = box - mid
-    tail = (spread * Interval(dx.lo[:, None, :], dx.hi[:, None, :])).isum(axis=2)
-    k = (Interval(mid) - yg) + tail
-    ok &= k.finite().all(axis=1)
-    inside = ok & (((k.lo > lo) & (k.hi < hi)) | free).all(axis=1)
-    apart = ok & (((k.hi < lo) | (k.lo > hi)) & ~free).any(axis=1)
-    verdict = np.where(inside, 1, np.where(apart, -1, 0))
-    return verdict, k.lo, k.hi
+        return krawczyk_step(lo, hi, g_mid, h)
+    both = ~free[:, :, None] & ~free[:, None, :]
+    eye = np.broadcast_to(np.eye(n), both.shape)
+    h = Interval(np.where(both, h.lo, eye), np.where(both, h.hi, eye))
+    g_mid = Interval(np.where(free, 0.0, g_mid.lo), np.where(free, 0.0, g_mid.hi))
+    return krawczyk_step(lo, hi, g_mid, h, free)
 
 
 def _roots(land: BoxLandscape, lo, hi, k_lo, k_hi, steps: int = 40) -> tuple:

@@ -96,3 +96,86 @@ def found_endpoints(variables, values: np.ndarray, rows) -> Endpoints:
         np.zeros(count), nan, nan, nan, np.ones(count, dtype=np.int64),
         np.zeros(count, dtype=bool),
     )  # fmt: skip
+
+
+def meet(a: Interval, b: Interval) -> Interval:
+    """The intersection of two enclosures of one quantity (each may be unbounded)."""
+    return Interval(np.maximum(a.lo, b.lo), np.minimum(a.hi, b.hi))
+
+
+def unit_enclosure(r: Interval, d: Interval) -> Interval:
+    """r / d over each box, r (B, dim) a link's vector and d (B,) its length: within [-1, 1]
+    whatever the box (a unit vector, or at d = 0 any vector of the unit ball: the Clarke
+    gradient of d there)."""
+    pos = (d.lo > 0)[:, None]
+    safe = Interval(np.where(pos, d.lo[:, None], 1.0), np.where(pos, d.hi[:, None], 1.0))
+    q = r / safe
+    return Interval(np.where(pos, np.maximum(q.lo, -1.0), -1.0),
+                    np.where(pos, np.minimum(q.hi, 1.0), 1.0))  # fmt: skip
+
+
+def cone_term(x: Link, dd: Interval, a: list, r: list, dr: list) -> list[Interval]:
+    """A spring's gradient k (d - L0) u . dr/dangle as k r . dr - k L0 u . dr over each box
+    (`a` the r . dr per angle, r and dr as the generated code lists them): finite where its
+    length may be 0, where k (1 - L0/d) r . dr is not."""
+    count = dd.lo.shape[0]
+    dim = len(r)
+    m = len(a)
+    u = unit_enclosure(matrix([r], count)[:, 0], dd.sqrt())
+    kl0 = np.asarray(x.k, dtype=float) * np.asarray(x.L0, dtype=float)
+    return [x.k * a[j] - kl0 * interval_sum(u[:, c] * dr[c * m + j] for c in range(dim))
+            for j in range(m)]  # fmt: skip
+
+
+def link_terms(x: Link, dd: Interval, a: Interval, r: Interval, J: Interval, M: Interval):
+    """A link's gradient (B, n) and Hessian (B, n, n) over each box, from r (B, dim), J = dr
+    (B, dim, n), a = J^T r and M = J^T J + sum_c r_c d2r_c: w a and w M + (k L0 / d) (J^T u)
+    (J^T u)^T (w = k (1 - L0/d); the gradient met with its cone form); a cable as its state
+    says: taut, 0 where slack, the hull of both where it may be either."""
+    count = dd.lo.shape[0]
+    w, state = force_density(x, dd)  # a cable's w: 0 where slack, with 0 where it may be
+    grad = scaled(a, w)
+    hess = scaled(M, w)
+    if x.L0 is not None:
+        d = dd.sqrt()
+        ju = (J * unit_enclosure(r, d)[:, :, None]).isum(axis=1)
+        kl0 = np.broadcast_to(np.asarray(x.k * x.L0, dtype=float), (count,))
+        hess = hess + scaled(ju[:, :, None] * ju[:, None, :], kl0 * d.reciprocal())
+        if not x.cable:  # a cable is slack near length 0: no cone
+            k = np.broadcast_to(np.asarray(x.k, dtype=float), (count,))
+            grad = meet(grad, scaled(a, k) - scaled(ju, kl0))
+    if x.cable:
+        zero = Interval(np.zeros(hess.lo.shape))
+        hess = Interval.where((state == TAUT)[:, None, None], hess, Interval.hull(zero, hess))
+        hess = Interval.where((state == SLACK)[:, None, None], zero, hess)
+    return grad, hess
+
+
+def scaled(v: Interval, s) -> Interval:
+    """Each box's block of v (B, ...) times its scale s ((B,) numbers or an Interval)."""
+    extra = v.lo.ndim - 1
+    if isinstance(s, Interval):
+        shape = s.lo.shape + (1,) * extra
+        return v * Interval(s.lo.reshape(shape), s.hi.reshape(shape))
+    s = np.asarray(s, dtype=float)
+    return v * (s.reshape(s.shape + (1,) * extra) if s.ndim else s)
+
+
+def add_diagonal(h: Interval, diag: Interval) -> Interval:
+    """h (B, n, n) plus diag (B, n) on its diagonal."""
+    n = h.lo.shape[1]
+    eye = np.eye(n, dtype=bool)
+    return h + Interval(np.where(eye, diag.lo[:, :, None], 0.0),
+                        np.where(eye, diag.hi[:, :, None], 0.0))  # fmt: skip
+
+
+def matrix(rows: list, count: int) -> Interval:
+    """Generated code's outputs (Intervals over `count` boxes, or constants) as one Interval
+    (count, rows, columns)."""
+    lo = np.empty((count, len(rows), len(rows[0])))
+    hi = np.empty_like(lo)
+    for i, row in enumerate(rows):
+        for j, v in enumerate(row):
+            v = Interval.of(v)
+            lo[:, i, j], hi[:, i, j] = v.lo, v.hi
+    return Interval(lo, hi)

@@ -33,16 +33,23 @@ from ..model.framework.units import normalized_slots
 from ..model.intervals import Interval, stack
 from .boxes import MIN_WIDTH, SHORT, BoxSearch, distinct, domain, search, search_each
 from .endpoints import Endpoints
+from .cones import ConeParts
 from .links import (
     EITHER,
     SLACK,
     TAUT,
     Link,
+    add_diagonal,
     columns,
+    cone_term,
     force_density,
     found_endpoints,
     interval_sum,
+    link_terms,
     links,
+    matrix,
+    meet,
+    scaled,
     taut_groups,
 )
 from .spheres import SphereFramework
@@ -102,6 +109,9 @@ class TorusFramework:
         self.renumber()
         self.free_springs = [i for i, x in enumerate(self.links) if x.L0 is not None
                              and not x.cable]  # fmt: skip
+        # backends.cones decides boxes through springs' cones (a spring's end moves in the
+        # plane as the angles turn: two or more of them)
+        self.cone_sets = self.n >= fw.dim
         self.member: np.ndarray | None = None  # a family's view: each box's member (rows)
         self.family: TorusFamily | None = None
 
@@ -158,33 +168,77 @@ class TorusFramework:
         """(sin, cos) of each body's angle over the boxes."""
         return [box[:, j].sin_cos() for j in range(len(self.bodies))]
 
-    def parts(self, box: Interval) -> tuple[list, list, list]:
-        """Per link its squared length and r . dr/dangle (n), and the loads' gradient."""
+    def parts(self, box: Interval) -> tuple[list, list, list, list, list]:
+        """Per link its squared length and r . dr/dangle (n), the loads' gradient, and per link
+        r (dim) and dr/dangle (dim x n, row by row)."""
         dim, m = self.fw.dim, self.n
         first = ball_module(self.full).first_order(self.pose(self.full, self.trig(box)), self.P)
-        per, dds, slopes = dim + dim * m, [], []
+        per, dds, slopes, rs, drs = dim + dim * m, [], [], [], []
         for i in range(len(self.links)):
             r, dr = first[i * per : i * per + dim], first[i * per + dim : (i + 1) * per]
             dds.append(interval_sum(Interval.of(c) * c for c in r))
             slopes.append(
                 [interval_sum(r[c] * dr[c * m + j] for c in range(dim)) for j in range(m)]
             )
-        return dds, slopes, first[len(self.links) * per :]
+            rs.append(r)
+            drs.append(dr)
+        return dds, slopes, first[len(self.links) * per :], rs, drs
 
     def enclose(self, box: Interval) -> tuple[Interval, Interval, dict]:
-        """(squared lengths of the free-length springs, grad V, the cables' states) per box."""
-        dds, slopes, loads = self.parts(box)
+        """(squared lengths of the free-length springs, grad V, the cables' states) per box.
+        A spring's term is also enclosed through its cone (cone_term): finite where its
+        length may be 0, and the two enclosures met where both hold."""
+        dds, slopes, loads, rs, drs = self.parts(box)
         shape = box.lo.shape[:1]
         grad = [Interval.of(np.broadcast_to(0.0, shape)) + g for g in loads]
         states = {}
-        for x, dd, a in zip(self.links, dds, slopes, strict=True):
+        for x, dd, a, r, dr in zip(self.links, dds, slopes, rs, drs, strict=True):
             w, state = force_density(x, dd)
             if x.cable:
                 states[x.name] = state
-            grad = [g + w * aj for g, aj in zip(grad, a, strict=True)]
+            terms = [w * aj for aj in a]
+            if x.L0 is not None and not x.cable and (dd.lo < np.square(x.L0)).any():
+                terms = [meet(t, c) for t, c in zip(terms, cone_term(x, dd, a, r, dr),
+                                                     strict=True)]  # fmt: skip
+            grad = [g + t for g, t in zip(grad, terms, strict=True)]
         lengths = stack([dds[i] for i in self.free_springs], axis=1) if self.free_springs else (
             Interval(np.zeros(shape + (0,))))  # fmt: skip
         return lengths, stack(grad, axis=1), states
+
+    def cone_parts(self, box: Interval, spring: np.ndarray) -> ConeParts:
+        """What backends.cones needs of each box about its spring `spring` (an index into the
+        free-length springs, per box) at zero length: V is A's potential minus k L0 d there.
+        The Hessians are summed link by link (each link's r is a sum of its bodies' turned
+        vectors, so d2r/dangle_j2 is dr/dangle_j a quarter turn on and the rest 0: read off
+        the generated first derivatives at the box turned by pi/2, as the loads' are)."""
+        dim, m, count = self.fw.dim, self.n, box.lo.shape[0]
+        dds, slopes, loads, rs, drs = self.parts(box)
+        _, _, loads2, _, drs2 = self.parts(box + np.pi / 2)
+        which = np.asarray(self.free_springs)[spring]
+        A = matrix([loads], count)[:, 0]
+        H = add_diagonal(Interval(np.zeros((count, m, m))), matrix([loads2], count)[:, 0])
+        r_s, J_s, J2_s, kl0 = None, None, None, np.zeros(count)
+        for i, (x, dd) in enumerate(zip(self.links, dds, strict=True)):
+            r = matrix([rs[i]], count)[:, 0]
+            J = matrix([drs[i][c * m : (c + 1) * m] for c in range(dim)], count)
+            J2 = matrix([drs2[i][c * m : (c + 1) * m] for c in range(dim)], count)
+            M = add_diagonal((J[:, :, :, None] * J[:, :, None, :]).isum(axis=1),
+                             (r[:, :, None] * J2).isum(axis=1))  # fmt: skip
+            a = matrix([slopes[i]], count)[:, 0]
+            grad, hess = link_terms(x, dd, a, r, J, M)
+            here = which == i
+            if here.any():  # the spring at its cone: k/2 d^2 in A, -k L0 d apart
+                k = np.broadcast_to(np.asarray(x.k, dtype=float), (count,))
+                grad = Interval.where(here[:, None], scaled(a, k), grad)
+                hess = Interval.where(here[:, None, None], scaled(M, k), hess)
+                kl0 = np.where(here, k * np.asarray(x.L0, dtype=float), kl0)
+                r_s = r if r_s is None else Interval.where(here[:, None], r, r_s)
+                J_s = J if J_s is None else Interval.where(here[:, None, None], J, J_s)
+                J2_s = J2 if J2_s is None else Interval.where(here[:, None, None], J2, J2_s)
+            A, H = A + grad, H + hess
+        lo, hi, idx = np.zeros((count, dim, m, m)), np.zeros((count, dim, m, m)), np.arange(m)
+        lo[:, :, idx, idx], hi[:, :, idx, idx] = J2_s.lo, J2_s.hi
+        return ConeParts(A, J_s, r_s, kl0, H, Interval(lo, hi))
 
     def hessian(self, box: Interval, states: dict) -> Interval:
         """The hull of the Hessians of every taut set each box allows (B, n, n)."""
@@ -268,7 +322,7 @@ class TorusFramework:
         return self._lengths(x)
 
     def _lengths(self, angles: np.ndarray) -> dict[str, np.ndarray]:
-        dds, _, _ = self.parts(Interval(angles))
+        dds = self.parts(Interval(angles))[0]
         return {x.name: np.sqrt(np.maximum(dd.mid, 0.0)) for x, dd in zip(self.links, dds,
                                                                           strict=True)}  # fmt: skip
 

@@ -58,7 +58,8 @@ def _solve_parser(sub) -> None:
     s.add_argument(
         "--workers",
         type=int,
-        help="local processes that share a framework's real search (default 1: this process)",
+        help="local processes that share a framework's real search (default: this process "
+        "for 2 s, then one a core)",
     )
     s.add_argument(
         "--certify",

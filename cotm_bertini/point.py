@@ -442,7 +442,7 @@ def _solve_real(
     from .analysis.framework_continua import absorb, continuum_record, find_continua
     from .backends.box_shares import split_search
     from .backends.boxes import SHORT
-    from .backends.real_route import critical_seeds, landscape
+    from .backends.real_route import landscape
     from .model.framework.units import units
 
     unit = units(fw)
@@ -452,18 +452,7 @@ def _solve_real(
             found = split_search(landscape, fw, SHORT, MIN_WIDTH, workers=settings.workers,
                                  scheduler=settings.scheduler, max_seconds=settings.timeout,
                                  label=f"real search of {fw.name}")  # fmt: skip
-        # Critical points the search could not prove: in boxes left undecided (a continuum
-        # passes there) or set aside next to a cone point (a saddle leaves the cone point as
-        # the other elements' pull there passes k L0): found by Newton, not proved unique.
-        # A search stopped by its budget leaves much undecided: more seeds, more rows found.
-        most = SEEDS_AT_BUDGET if found.budget_hit else 32
-        seeds = land.fresh(np.vstack([critical_seeds(land, found.undecided, most),
-                                      critical_seeds(land, found.set_aside_boxes)]),
-                           found.roots)  # fmt: skip
-        descents = _descents(land, found, seeds, settings.seed)
-        seeds = np.vstack([seeds, land.fresh(descents["points"], np.vstack([found.roots, seeds]))])
-        regions = free_regions(land, found, unit)
-        seeds = seeds[~in_regions(land, seeds, regions, unit)]
+        seeds, descents, regions = _unproved(land, found, unit, settings.seed)
         groups = land.endpoints(np.vstack([found.roots, seeds]))
     report: dict = {" ".join(taut) or "none": {"excluded": True, "pruned": "bound smoothing",
                     "note": why.note()} for taut, why in pruned.items()}  # fmt: skip
@@ -512,6 +501,23 @@ def _solve_real(
         t.stages, None,
         tuple(continuum_record(c, n) for n, c in enumerate(continua, start=1)),
     )  # fmt: skip
+
+
+def _unproved(land, found, unit: tuple[float, float], seed: int | None) -> tuple:
+    """(seeds, descents, regions): the critical points the search could not prove, in boxes
+    left undecided (a continuum passes there) or set aside next to a cone point, found by
+    Newton (not proved unique; a search stopped by its budget leaves much undecided: more
+    seeds, more rows found) and by descents; the free regions, whose points are not rows."""
+    from .backends.real_route import critical_seeds
+
+    most = SEEDS_AT_BUDGET if found.budget_hit else 32
+    seeds = land.fresh(np.vstack([critical_seeds(land, found.undecided, most),
+                                  critical_seeds(land, found.set_aside_boxes)]),
+                       found.roots)  # fmt: skip
+    descents = _descents(land, found, seeds, seed)
+    seeds = np.vstack([seeds, land.fresh(descents["points"], np.vstack([found.roots, seeds]))])
+    regions = free_regions(land, found, unit)
+    return seeds[~in_regions(land, seeds, regions, unit)], descents, regions
 
 
 def _descents(land, found, seeds, seed: int | None) -> dict:

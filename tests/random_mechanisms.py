@@ -187,7 +187,8 @@ def chain_cone_points(ch: Chain, starts: int = 3000, seed: int = 1) -> list[dict
         y = np.hstack([rng.uniform(0, 2 * np.pi, (starts, n)), rng.normal(0, k * L0, (starts, 2))])
         for _ in range(40):
             with np.errstate(all="ignore"):
-                D = np.stack([(lag(y + 1e-6 * v) - lag(y - 1e-6 * v)) / 2e-6 for v in np.eye(n + 2)], 2)
+                D = np.stack([lag(y + 1e-6 * v) - lag(y - 1e-6 * v) for v in np.eye(n + 2)], 2)
+                D /= 2e-6
             F = lag(y)
             bad = ~(np.isfinite(D).all(axis=(1, 2)) & np.isfinite(F).all(axis=1))
             D[bad], F[bad] = np.eye(n + 2), 0.0  # at another spring's cone: that start stops

@@ -213,7 +213,8 @@ def morse_count(fw: Framework, table: dict, continua: list = (), near_cones=None
     minima = sum(c.index == 0 for c in continua)
     ok = total == chi and counts["degenerate"] == 0 and counts["min"] + minima > 0
     return {"applicable": True, "manifold": " x ".join(factors), "expected": chi, **counts,
-            "zero_length_maxima": maxima, "cone_points": len(cone_terms), "continua": len(continua), "continua_minima": minima,
+            "zero_length_maxima": maxima, "cone_points": len(cone_terms),
+            "continua": len(continua), "continua_minima": minima,
             "continua_term": sum(t for t, _ in terms), "euler_characteristic": total,
             "ok": ok}  # fmt: skip
 

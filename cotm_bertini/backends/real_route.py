@@ -32,8 +32,8 @@ from ..model.framework.structure import layout
 from ..model.framework.units import normalized_slots
 from ..model.intervals import Interval, stack
 from .boxes import MIN_WIDTH, SHORT, BoxSearch, distinct, domain, search, search_each
-from .endpoints import Endpoints
 from .cones import ConeParts
+from .endpoints import Endpoints
 from .links import (
     EITHER,
     SLACK,

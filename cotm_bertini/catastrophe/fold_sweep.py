@@ -335,7 +335,11 @@ def _turning_folds(cs: CurveSystem, spec, branches: list[Traced]) -> tuple[list,
         for za, zb in _turns(b, spec):
             counts["turns"] += 1
             turn = turning_point(eqs, za, zb, along, win, TURN_HALVINGS)
-            if turn is not None and forces and np.abs(turn[forces]).max() <= SAME:
+            ends = [z for z in (turn,) if z is not None] or [za, zb]
+            # A turn at a relaxed pose (every force density 0, located or, where Newton cannot
+            # locate it there, at one end of the bracket): the fold system is singular there,
+            # and the relaxed folds have their own.
+            if forces and any(np.abs(z[forces]).max() <= SAME for z in ends):
                 counts["relaxed"] += 1
                 continue
             hit = None if turn is None else _line_newton(fold_eqs, turn, spec)

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import multiprocessing
 import time
 from collections.abc import Callable
 
@@ -67,7 +68,8 @@ def split_search(
     if workers is None and scheduler is not None:
         workers = 1  # the cluster's workers take the shares
     elif workers is None:
-        workers = default_workers()
+        # a worker of a pool already (a sweep's point, an event's solve): this process only
+        workers = 1 if multiprocessing.parent_process() is not None else default_workers()
         probe = PROBE_SECONDS if max_seconds is None else min(PROBE_SECONDS, max_seconds)
         if workers == 1:
             return search(land, short, min_width, start, max_boxes, max_seconds, label)

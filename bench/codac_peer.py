@@ -8,20 +8,25 @@ turns by its absolute angle about the pin that places it), V = sum k/2 (d - L0)^
 + sum k/2 max(d - L0, 0)^2 over cables - F . x over loads, differentiated by sympy (the
 cables' max kept: codac evaluates max on intervals and differentiates it for its centered
 form, so no taut and slack pieces), and written as a codac AnalyticFunction (sympy's common
-subexpressions shared). It is checked against the package's grad V (normalised units, scaled
-back by k_unit L_unit^2) at random angles before any timing.
+subexpressions named, though codac evaluates each use again). It is checked against the
+package's grad V (normalised units, scaled back by k_unit L_unit^2) at random angles before
+any timing.
 
 codac: CtcInverse(grad V, 0) (forward-backward contraction with the centered form, codac's
-default) in codac's own paver `pave(x0, ctc, eps)` with eps = MIN_WIDTH (1e-4 rad): a box is
-contracted, dropped when empty, kept when narrower than eps, else bisected. A codac "box" is
-a node of the paving tree (one contraction each); its roots are the connected subsets of the
-kept boxes (an outer enclosure: no existence or uniqueness proof). Ours: search(landscape(fw),
-SHORT, MIN_WIDTH), one warm run timed; a "box" is a box the search decided (excluded, proved
-to hold one critical point or none by the Krawczyk test, split, set aside or left undecided);
-its roots come with existence and uniqueness proofs. Both single-threaded (codac's nb_threads
-is 1; numpy here runs on one core).
+default; --fixpoint: CtcFixpoint of it) in codac's `pave` loop (codac2_pave.cpp: first in,
+first out; a box is contracted, dropped when empty, kept when no wider than eps = MIN_WIDTH,
+1e-4 rad, else bisected), written here so that it stops at a budget (pave's own time argument
+did not stop it). A codac "box" is one contraction (a node of the paving tree; --fixpoint:
+one fixpoint call, several contractions); its roots are
+clusters of kept boxes closer than eps (an outer enclosure: no existence or uniqueness proof),
+those where a spring is near zero length (CONE) counted apart as cone points. Ours:
+search(landscape(fw), SHORT, MIN_WIDTH), one warm run timed; a "box" is a box the search
+decided (excluded, proved to hold one critical point or none by the Krawczyk test, split, set
+aside or left undecided); its roots come with existence and uniqueness proofs. codac runs on
+one thread (nb_threads 1).
 
-Usage: python bench/codac_peer.py [--only NAME ...] [--budget SECONDS]
+Usage: python bench/codac_peer.py [--only NAME ...] [--codac-budget S] [--ours-budget S]
+[--fixpoint]
 """
 
 from __future__ import annotations

@@ -186,6 +186,19 @@ class Progress:
             return None
         return max(0.0, (now - t0) / (self.done - d0) * (self.total - self.done))
 
+    @property
+    def falling(self) -> bool:
+        """Whether a fraction's pace over its last window is under half that of the window
+        before (a search's last boxes are its hardest): then the time left at the last pace
+        is a floor, and the line says so."""
+        now = time.perf_counter()
+        span = max(WINDOW, (now - self.start) / 3)
+        if not isinstance(self.total, float) or now - self.start < 2 * span:
+            return False
+        t1, d1 = next((t, d) for t, d in reversed(self._history) if now - t >= span)
+        t0, d0 = next((t, d) for t, d in reversed(self._history) if now - t >= 2 * span)
+        return (self.done - d1) / max(now - t1, 1e-9) < 0.5 * (d1 - d0) / max(t1 - t0, 1e-9)
+
     def update(self, n: float = 1, note: str | None = None) -> None:
         """`n` more units done; `note`: what to show after the count (e.g. paths lost)."""
         with self._lock:
@@ -258,7 +271,9 @@ class Progress:
             parts.append(f"{duration(self.rate)} a {_one(self.unit)}")
         parts.append(f"{duration(self.elapsed)} so far")
         left = self.left
-        if left is not None:
+        if left is not None and self.falling:
+            parts.append(f"at least about {duration(left)} left (the pace is falling)")
+        elif left is not None:
             parts.append(f"about {duration(left)} left")
         elif isinstance(self.total, float):
             parts.append("time left not known yet")

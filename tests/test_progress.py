@@ -252,9 +252,12 @@ def test_a_fraction_s_time_left_is_at_its_recent_rate_and_unknown_when_it_stalls
     for t in range(11, 61):  # then 0.01% a second for 50 s
         clock[0] = float(t)
         p.set(0.9 + 0.0001 * (t - 10))
+        if t == 25:  # the last 10 s crawled, the 10 s before raced: a floor, said so
+            assert p.falling and "at least about" in p.line() and "pace is falling" in p.line()
     # the last window (20 s, a third of 60) decided 0.002: 0.095 left takes 950 s at that pace
     assert p.left == pytest.approx(0.095 / 0.002 * 20, rel=1e-6)
     assert p.left > 100 * (p.elapsed / p.done) * (1 - p.done)  # the average would say ~6 s
+    assert not p.falling and "about 16 min left" in p.line() and "at least" not in p.line()
     clock[0] = 100.0  # 40 s with nothing decided
     assert p.left is None and "time left not known yet" in p.line()
     p.close()

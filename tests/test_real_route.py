@@ -502,3 +502,24 @@ def test_a_seed_lines_branches_are_traced_once_for_a_taut_sets_curve_systems():
     other = curve_system(fw, one, "x", "y", "band_p")
     ts = np.linspace(0.0, 1.0, 3)
     assert branch_key(other, specs[0], ts, []) != branch_key(switch, specs[0], ts, [])
+
+
+def test_a_family_covered_together_proves_each_point_as_alone():
+    """search_frameworks excludes what no point of a family can have a critical point in once,
+    over their hull (every number an interval holding each point's), then searches each point
+    from what is left: each point's proved roots equal its own search's (4-link chain, 20
+    values of a free length, a cable-free chain where one point would take 125k boxes)."""
+    from cotm_bertini.backends.boxes import MIN_WIDTH, SHORT, search
+    from cotm_bertini.backends.real_route import TorusFramework, search_frameworks
+
+    fw = cb.Framework.from_toml(ROOT / "tests" / "fixtures" / "chain4.toml")
+    fws = [fw.replace(L0=v) for v in np.linspace(1.6, 2.0, 20)]
+    lands = [TorusFramework(f) for f in fws]
+    found = search_frameworks(fws, lands=lands)
+    for k in (0, 7, 19):
+        alone = search(lands[k], SHORT, MIN_WIDTH)
+        got = found[k]
+        assert not got.budget_hit and len(got.undecided) == 0 == len(alone.undecided)
+        a, b = (r[np.lexsort(r.T[::-1])] for r in (got.roots, alone.roots))
+        assert len(a) == len(b) > 0 and np.abs(a - b).max() < 1e-9
+        assert got.boxes < alone.boxes and "together first" in got.notes[-1]

@@ -179,16 +179,45 @@ def search_each(
     max_boxes: int | None = None,
     max_seconds: float | None = None,
     label: str = "real search",
+    boxes: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> list[BoxSearch]:
     """`search` of each member of a family (one landscape at several parameter values) over
-    the whole domain, all in the same batches of boxes: each member's search takes the steps
-    its own search would (its boxes, roots and lists equal, in the same order), and a batch
-    holds every member's step, so numpy's loops, not Python, set the pace. `max_boxes` is
-    each member's; `max_seconds` each member's share of the time (all stop at
-    members x max_seconds)."""
-    first = domain(family, start)
+    the whole domain, or over `boxes` (lo, hi) where given (the rest of the domain known to
+    hold no critical point of any member: `cover`), all in the same batches of boxes: each
+    member's search takes the steps its own search of those boxes would (its boxes, roots and
+    lists equal, in the same order), and a batch holds every member's step, so numpy's loops,
+    not Python, set the pace. `max_boxes` is each member's; `max_seconds` each member's share
+    of the time (all stop at members x max_seconds)."""
+    first = domain(family, start) if boxes is None else boxes
+    whole = (
+        None
+        if boxes is None
+        else float(np.prod(domain(family, start)[1] - domain(family, start)[0], axis=1).sum())
+    )
     return _search(family, family.members, first, short, min_width, max_boxes, max_seconds,
-                   label)  # fmt: skip
+                   label, whole)  # fmt: skip
+
+
+def cover(land: BoxLandscape, first: tuple[np.ndarray, np.ndarray], stop: float = 0.2,
+          ) -> tuple[tuple[np.ndarray, np.ndarray], int]:  # fmt: skip
+    """The boxes of `first` (lo, hi) that the enclosure of grad V does not exclude, halved (as
+    `_split`) until no wider than `stop`, and the boxes looked at. Over a family's hull
+    (TorusFamily.hull: every number an interval holding each member's) a box excluded holds
+    no critical point of any member, so their searches start from what is left."""
+    todo, keep, count = [first], [], 0
+    while todo:
+        lo, hi = _take(todo, BATCH)
+        count += len(lo)
+        _, grad, _ = land.enclose(Interval(lo, hi))
+        live = grad.contains_zero().all(axis=1)
+        lo, hi = lo[live], hi[live]
+        small = (hi - lo).max(axis=1) <= stop
+        keep.append((lo[small], hi[small]))
+        if (~small).any():
+            a, b, _ = _split(lo[~small], hi[~small], np.arange(int((~small).sum())))
+            todo.append((a, b))
+    n = first[0].shape[1]
+    return (_rows([a for a, _ in keep], n), _rows([b for _, b in keep], n)), count
 
 
 @dataclass
@@ -246,9 +275,11 @@ class _Member:
         )  # fmt: skip
 
 
-def _search(land, members: int, first: tuple, short, min_width, max_boxes, max_seconds, label):
+def _search(land, members: int, first: tuple, short, min_width, max_boxes, max_seconds, label,
+            whole: float | None = None):  # fmt: skip
     """The members' searches in lockstep: each step takes every live member's next batch (as
-    its own search would) into one call of `_step`, and hands each its rows of the outcome."""
+    its own search would) into one call of `_step`, and hands each its rows of the outcome.
+    `whole`: the volume of the domain where `first` is only the part left to search."""
     t0, c0 = time.perf_counter(), time.process_time()
     n = first[0].shape[1]
     volume = float(np.prod(first[1] - first[0], axis=1).sum())
@@ -281,7 +312,7 @@ def _search(land, members: int, first: tuple, short, min_width, max_boxes, max_s
         report.set(1.0 - pending / members, note=f"{sum(m.boxes for m in group):,} boxes")
     report.close()
     clocks = ((time.perf_counter() - t0) / members, (time.process_time() - c0) / members)
-    return [m.result(n, clocks, volume) for m in group]
+    return [m.result(n, clocks, whole or volume) for m in group]
 
 
 def spread(

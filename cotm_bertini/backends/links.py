@@ -56,18 +56,28 @@ def force_density(x: Link, dd: Interval) -> tuple[Interval, np.ndarray]:
     """w over each box from the squared length `dd`, and a cable's state there (TAUT, SLACK
     or EITHER: then w is enclosed by the hull of 0 and k (1 - L0/d))."""
     shape = dd.lo.shape
+    k = Interval.of(x.k)
     if x.L0 is None:
-        return Interval(np.full(shape, x.k)), np.full(shape, TAUT)
+        return Interval(np.broadcast_to(k.lo, shape), np.broadcast_to(k.hi, shape)), np.full(
+            shape, TAUT)  # fmt: skip
     w = x.k * (1.0 - x.L0 / dd.sqrt())
     if not x.cable:
         return w, np.full(shape, TAUT)
-    l2 = x.L0 * x.L0
-    state = np.where(dd.lo > l2, TAUT, np.where(dd.hi < l2, SLACK, EITHER))
+    low, high = squared_bounds(x.L0)
+    state = np.where(dd.lo > high, TAUT, np.where(dd.hi < low, SLACK, EITHER))
     hull_lo = np.where(np.isfinite(w.lo), np.minimum(w.lo, 0.0), 0.0)
-    hull_hi = np.where(np.isfinite(w.hi), np.maximum(w.hi, 0.0), x.k)
+    hull_hi = np.where(np.isfinite(w.hi), np.maximum(w.hi, 0.0), k.hi)
     lo = np.where(state == TAUT, w.lo, np.where(state == SLACK, 0.0, hull_lo))
     hi = np.where(state == TAUT, w.hi, np.where(state == SLACK, 0.0, hull_hi))
     return Interval(lo, hi), state
+
+
+def squared_bounds(L0) -> tuple:
+    """(least, largest) L0^2: a free length is a number, one per box, or an interval of them
+    (a family of frameworks enclosed at once: TorusFamily.hull)."""
+    if isinstance(L0, Interval):
+        return L0.lo * L0.lo, L0.hi * L0.hi
+    return L0 * L0, L0 * L0
 
 
 def columns(values: list, count: int) -> np.ndarray:
@@ -122,7 +132,7 @@ def cone_term(x: Link, dd: Interval, a: list, r: list, dr: list) -> list[Interva
     dim = len(r)
     m = len(a)
     u = unit_enclosure(matrix([r], count)[:, 0], dd.sqrt())
-    kl0 = np.asarray(x.k, dtype=float) * np.asarray(x.L0, dtype=float)
+    kl0 = x.k * x.L0  # numbers, per box, or intervals (TorusFamily.hull)
     return [x.k * a[j] - kl0 * interval_sum(u[:, c] * dr[c * m + j] for c in range(dim))
             for j in range(m)]  # fmt: skip
 

@@ -169,3 +169,20 @@ def test_a_time_limit_stops_every_share_and_says_so():
     found = res.record["details"]["real_search"]
     assert res.status == "incomplete" and found["undecided"] > 0 and found["shares"] == 2
     assert re.search(r"left \d+ boxes undecided .*2 of 2 shares stopped at", res.warnings[0])
+
+
+def test_by_default_a_search_probes_in_process_then_shares_what_is_left(monkeypatch):
+    """workers=None (solve's default): the search runs here for PROBE_SECONDS; a search done by
+    then is that plain search (no process started), one that is not goes on over one process
+    a core from the boxes it left, and proves the same roots (chain3, probes of 60 s and of
+    0.3 s, two cores)."""
+    monkeypatch.setattr(box_shares, "default_workers", lambda: 2)
+    fw = cb.Framework.from_toml(FILE)
+    plain = search(landscape(fw), SHORT, MIN_WIDTH)
+    monkeypatch.setattr(box_shares, "PROBE_SECONDS", 60.0)
+    here = box_shares.split_search(landscape, fw, SHORT, MIN_WIDTH, workers=None)
+    assert here.shares == 1 and here.boxes == plain.boxes
+    monkeypatch.setattr(box_shares, "PROBE_SECONDS", 0.3)
+    shared = box_shares.split_search(landscape, fw, SHORT, MIN_WIDTH, workers=None)
+    assert shared.shares >= 2 and not shared.budget_hit and len(shared.undecided) == 0
+    np.testing.assert_allclose(_sorted(shared.roots), _sorted(plain.roots), atol=SAME)

@@ -188,12 +188,9 @@ def search_each(
     lists equal, in the same order), and a batch holds every member's step, so numpy's loops,
     not Python, set the pace. `max_boxes` is each member's; `max_seconds` each member's share
     of the time (all stop at members x max_seconds)."""
-    first = domain(family, start) if boxes is None else boxes
-    whole = (
-        None
-        if boxes is None
-        else float(np.prod(domain(family, start)[1] - domain(family, start)[0], axis=1).sum())
-    )
+    lo, hi = domain(family, start)
+    whole = float(np.prod(hi - lo, axis=1).sum())
+    first = (lo, hi) if boxes is None else boxes
     return _search(family, family.members, first, short, min_width, max_boxes, max_seconds,
                    label, whole)  # fmt: skip
 

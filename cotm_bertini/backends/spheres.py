@@ -223,12 +223,8 @@ class SphereFramework:
         return ok
 
     def floating(self) -> dict[int, list[str]]:
-        """Per node that can float: the cables whose slackness frees it (module `free`); none
-        where one of them is taut in every pose (its reach bounds say so: prism4's diagonals),
-        which saves the test on every box."""
+        """Per node that can float: the cables whose slackness frees it (module `free`)."""
         touches = [set(np.flatnonzero(np.abs(s).sum(axis=0)) // 3) for s in self.stencil]
-        always = {x.name for x in self.links if x.cable and x.L0 is not None
-                  and self._shortest(x.name) > x.L0}  # fmt: skip
         loaded = {ld.point for ld in self.fw.loads
                   if any(self.slots[f"f_{ld.name}_{c}"] for c in "xyz")}  # fmt: skip
         out = {}
@@ -238,27 +234,9 @@ class SphereFramework:
                 continue
             crossing = [x for x, t in zip(self.links, touches, strict=True)
                         if t & hang and (len(t) == 1 or not t <= hang)]  # fmt: skip
-            if all(x.cable and x.L0 is not None and x.name not in always for x in crossing):
+            if all(x.cable and x.L0 is not None for x in crossing):
                 out[i] = [x.name for x in crossing]
         return out
-
-    def _shortest(self, cable: str) -> float:
-        """A lower bound of the cable's length over every pose (normalised units): its ends'
-        ground points apart, less the bars each end hangs by (0 where that bound is not
-        positive, or an end is not a node or ground point)."""
-        x = next(c for c in self.fw.cables if c.name == cable)
-        ends = []
-        for point in (x.a, x.b):
-            reach = 0.0
-            while point in self.parent:
-                reach += self.length[point]
-                point = self.parent[point]
-            name = point.removeprefix("ground.")
-            if point == name or f"g_{name}_x" not in self.slots:
-                return 0.0
-            ends.append((np.array([self.slots[f"g_{name}_{c}"] for c in "xyz"]), reach))
-        (p, a), (q, b) = ends
-        return max(0.0, float(np.linalg.norm(p - q)) - a - b)
 
     def subtree(self, node: str) -> list[int]:
         """Indices of the nodes that hang from `node` (itself included)."""

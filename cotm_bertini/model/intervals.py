@@ -31,28 +31,16 @@ def _down(x: np.ndarray) -> np.ndarray:
     """A double below every real number that rounds to x: x - |x| eps lies at or beyond the
     next double below, and rounding is monotone (several times cheaper than nextafter); an
     overflow to +inf moves back to the largest double (a lower bound is never +inf)."""
-    with np.errstate(invalid="ignore", over="ignore"):  # in place: a fifth of a search's time
-        if type(x) is not np.ndarray or x.ndim == 0 or x.dtype != np.float64:
-            out = x - (np.abs(x) * _EPS + _TINY)
-        else:
-            out = np.abs(x)
-            out *= _EPS
-            out += _TINY
-            np.subtract(x, out, out=out)
-    return np.where(x == INF, _MAX, out) if np.any(out != out) else out
+    with np.errstate(invalid="ignore", over="ignore"):
+        out = x - (np.abs(x) * _EPS + _TINY)
+    return np.where(x == INF, _MAX, out)
 
 
 def _up(x: np.ndarray) -> np.ndarray:
     """A double above every real number that rounds to x (see _down)."""
     with np.errstate(invalid="ignore", over="ignore"):
-        if type(x) is not np.ndarray or x.ndim == 0 or x.dtype != np.float64:
-            out = x + (np.abs(x) * _EPS + _TINY)
-        else:
-            out = np.abs(x)
-            out *= _EPS
-            out += _TINY
-            np.add(x, out, out=out)
-    return np.where(x == -INF, -_MAX, out) if np.any(out != out) else out
+        out = x + (np.abs(x) * _EPS + _TINY)
+    return np.where(x == -INF, -_MAX, out)
 
 
 def _clean(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

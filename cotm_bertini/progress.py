@@ -80,7 +80,9 @@ def say(text: str, force: bool = False) -> None:
 
 
 def duration(seconds: float) -> str:
-    """A time for people: 0.4 s, 45 s, 4 min 10 s, 3.2 h."""
+    """A time for people: 0.4 s, 45 s, 4 min 10 s, 3.2 h (under a millisecond: 0 s)."""
+    if seconds < 1e-3:
+        return "0 s"
     if seconds < 10:
         return f"{seconds:.2g} s"
     if seconds < 90:

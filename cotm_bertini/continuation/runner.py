@@ -192,9 +192,10 @@ def _run_task(args: tuple) -> list[tuple[int, Columns, int, str | None]]:
 
 def point_settings(spec: SweepSpec) -> Settings:
     """The settings of each point: the sweep's, one thread a point unless threads were given,
-    and no scheduler (the sweep's generic sets are split before its points start, and a point
-    solved on a Dask worker must not wait for other tasks of its own cluster)."""
-    settings = Settings(**spec.settings).replace(scheduler=None)
+    no scheduler (the sweep's generic sets are split before its points start, and a point
+    solved on a Dask worker must not wait for other tasks of its own cluster), and its search
+    in its own process (an event's many solves would each start a pool of processes)."""
+    settings = Settings(**spec.settings).replace(scheduler=None, workers=1)
     return settings if settings.threads is not None else settings.replace(threads=1)
 
 

@@ -432,29 +432,29 @@ def search_frameworks(
     return out
 
 
-def _search_family(fws, lands, members: list[int], max_seconds, out: list, first, stop=None):
-    """search_each of the frameworks `members`, after what none of them can have a critical
-    point in is excluded once for all (their hull's enclosures: boxes.cover, to `stop` rad);
-    halves of a larger family are covered again from what is left (their hulls are tighter),
-    down to FAMILY_LEAF members."""
-    family = TorusFamily([lands[k] for k in members])
-    stop = COVER_WIDTH if stop is None else stop
+def _search_family(fws, lands, members: list[int], max_seconds, out: list, first,
+                   stop: float = COVER_WIDTH, shared: dict | None = None) -> None:  # fmt: skip
+    """search_each of the frameworks `members` (their records into `out`), after what none of
+    them can have a critical point in is excluded once for all (their hull's enclosures:
+    boxes.cover, to `stop` rad); halves of a larger family are covered again from what is
+    left (their hulls are tighter), down to FAMILY_LEAF members. `shared`: each member's share
+    of the boxes covered so far."""
+    family, shared = TorusFamily([lands[k] for k in members]), dict(shared or {})
     if len(members) > 1:
         first, looked = cover(family.hull(), first, stop)
         for k in members:
-            lands[k].__dict__.setdefault("_covered", []).append(looked / len(members))
+            shared[k] = shared.get(k, 0.0) + looked / len(members)
     if len(members) > FAMILY_LEAF:
         half = (len(members) + 1) // 2
         for part in (members[:half], members[half:]):
-            _search_family(fws, lands, part, max_seconds, out, first, stop / 2)
+            _search_family(fws, lands, part, max_seconds, out, first, stop / 2, shared)
         return
     label = f"real search of {fws[members[0]].name}, {len(members)} points"
     found = search_each(family, SHORT, MIN_WIDTH, max_seconds=max_seconds, label=label,
                         boxes=first if len(members) > 1 else None)  # fmt: skip
     for k, f in zip(members, found, strict=True):
-        shared = sum(lands[k].__dict__.pop("_covered", []))
-        if shared:
-            f.notes.append(f"{shared:,.0f} boxes (a share of those searched for its "
+        if shared.get(k):
+            f.notes.append(f"{shared[k]:,.0f} boxes (a share of those searched for its "
                            "neighbours and it together first)")  # fmt: skip
         out[k] = f
 

@@ -270,3 +270,13 @@ def test_chain3_collapse_is_proved_with_its_cone_points_and_a_lost_one_is_a_cont
     monkeypatch.setattr(boxes, "cone_test", lossy)
     bad = cb.solve(fw, route="real", cache=False)
     assert bad.status == "contradiction" and "Morse count" in bad.warnings[0]
+
+
+def test_the_solve_report_names_each_cone_point():
+    """The console report of a solve lists each proved cone point in a line: its spring, pose,
+    the pull against k L0 and its index (from run.json's real_search.cone_points)."""
+    fw = cb.Framework.from_toml(ROOT / "tests" / "fixtures" / "chain3_collapse.toml")
+    res = cb.solve(fw, route="real", cache=False)
+    lines = [ln for ln in res.record["summary"].splitlines() if ln.startswith("cone point ")]
+    assert len(lines) == 2 and all("spring s2 at zero length" in ln for ln in lines)
+    assert all("< k L0 = 2.7" in ln and "index 2" in ln for ln in lines)

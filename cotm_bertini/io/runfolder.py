@@ -90,9 +90,22 @@ def summary_text(record: dict, table: dict) -> str:
         lines.append(f"{others} other {_plural(others, 'row')} in the run folder's solutions.csv "
                      f"({_others_text(table)}; its column reason says why)")  # fmt: skip
     lines += [continuum_line(c) for c in record.get("continua", [])]
-    regions = record.get("details", {}).get("real_search", {}).get("free_regions", [])
-    lines += [region_line(r) for r in regions]
+    search = record.get("details", {}).get("real_search", {})
+    lines += [region_line(r) for r in search.get("free_regions", [])]
+    lines += [cone_line(k, c) for k, c in enumerate(search.get("cone_points", []), start=1)]
     return "\n".join(lines)
+
+
+def cone_line(k: int, c: dict) -> str:
+    """A cone point in a line: the spring at zero length, the pose, the pull against k L0."""
+    pose = ", ".join(f"{b} {a:.4f}" for b, a in c["angles_deg"].items()) if isinstance(
+        c["angles_deg"], dict) else ", ".join(f"{a:.4f}" for a in c["angles_deg"])  # fmt: skip
+    return (
+        f"cone point {k}: spring {c['spring']} at zero length ({pose} deg), the others' pull "
+        f"{c['pull']:.6g} < k L0 = {c['push']:.6g}: a critical point of V, not an "
+        f"equilibrium row (index {c['index']}, {c['kind']}; run.json "
+        "real_search.cone_points)"
+    )
 
 
 def region_line(r: dict) -> str:

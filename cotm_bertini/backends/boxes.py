@@ -40,6 +40,7 @@ import numpy as np
 from ..model.intervals import Interval
 from ..progress import Progress
 from .cones import cone_test, near_cone
+from .cones import sub_landscape as _sub
 from .krawczyk import krawczyk_step
 
 TWO_PI = 2 * math.pi
@@ -623,12 +624,6 @@ def _cone_tested(land, lo, hi, at, spring) -> tuple:
 def _spring_bound(dd_hi: np.ndarray) -> np.ndarray:
     """In each box set aside some spring with a free length is at most this long."""
     return np.sqrt(np.maximum(dd_hi.min(axis=1), 0.0)) if dd_hi.shape[1] else np.zeros(len(dd_hi))
-
-
-def _sub(land, rows: np.ndarray):
-    """The landscape over the batch's boxes `rows` (a family's view keeps each box's member)."""
-    sub = getattr(land, "sub", None)
-    return land if sub is None else sub(rows)
 
 
 def _root_near(land: BoxLandscape, lo: np.ndarray, hi: np.ndarray, steps: int = 8) -> np.ndarray:

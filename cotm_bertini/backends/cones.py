@@ -102,25 +102,27 @@ def cone_test(land, lo: np.ndarray, hi: np.ndarray, spring: np.ndarray) -> tuple
     empty = (np.zeros((0, n)), np.zeros((0, dim)), np.zeros(0, dtype=np.int64))
     if not len(at):
         return verdict, empty, at
-    rho = z_hi[at] / (1 - e[at])
-    pad = (e[at] * rho)[:, None]
-    lam = Interval(np.maximum(z.lo[at] - pad, -rho[:, None]) * kl0[at, None],
-                   np.minimum(z.hi[at] + pad, rho[:, None]) * kl0[at, None])  # fmt: skip
+    rho = z_hi[at] / (1 - e[at]) * (1 + ROUND)
+    pad = (e[at] * rho * (1 + ROUND))[:, None]
+    v = Interval(np.maximum(z.lo[at] - pad, -rho[:, None]), np.minimum(z.hi[at] + pad,
+                                                                       rho[:, None]))  # fmt: skip
+    lam = v * Interval(kl0[at, None])  # rounded outwards: it must hold every lambda
     y_lo, y_hi = np.hstack([lo[at], lam.lo]), np.hstack([hi[at], lam.hi])
-    sub = _sub(land, at)
-    g_mid = _lagrange(sub, 0.5 * (y_lo + y_hi), spring[at], n)
+    sub = sub_landscape(land, at)
+    mid = 0.5 * (y_lo + y_hi)
+    g_mid = _lagrange(sub.cone_parts(Interval(mid[:, :n]), spring[at]), mid, n)
     v, k_lo, k_hi = krawczyk_step(y_lo, y_hi, g_mid, _jacobian(_rows(p, at), lam))
     verdict[at] = v
     one = np.flatnonzero(v == 1)
     if not len(one):
         return verdict, empty, at[one]
-    y = _newton(_sub(sub, one), np.maximum(y_lo[one], k_lo[one]),
-                np.minimum(y_hi[one], k_hi[one]), spring[at[one]], n)  # fmt: skip
-    return verdict, (y[:, :n], y[:, n:], _index(_sub(sub, one), y, spring[at[one]], n)), at[one]
+    sub, which = sub_landscape(sub, one), spring[at[one]]
+    y = _newton(sub, np.maximum(y_lo[one], k_lo[one]), np.minimum(y_hi[one], k_hi[one]), which, n)
+    return verdict, (y[:, :n], y[:, n:], _index(sub, y, which, n)), at[one]
 
 
-def _sub(land, rows: np.ndarray):
-    """The landscape over the boxes `rows` (a family's view keeps each box's member)."""
+def sub_landscape(land, rows: np.ndarray):
+    """The landscape over the batch's boxes `rows` (a family's view keeps each box's member)."""
     sub = getattr(land, "sub", None)
     return land if sub is None else sub(rows)
 
@@ -129,9 +131,9 @@ def _rows(p: ConeParts, rows: np.ndarray) -> ConeParts:
     return ConeParts(p.A[rows], p.J[rows], p.r[rows], p.kl0[rows], p.H[rows], p.R2[rows])
 
 
-def _lagrange(land, y: np.ndarray, spring: np.ndarray, n: int) -> Interval:
-    """G = (A - J^T lambda, r) at points y = (angles, lambda) (B, n + dim), rounded outwards."""
-    p = land.cone_parts(Interval(y[:, :n]), spring)
+def _lagrange(p: ConeParts, y: np.ndarray, n: int) -> Interval:
+    """G = (A - J^T lambda, r) at points y = (angles, lambda) (B, n + dim), rounded outwards
+    (`p`: the parts at those angles)."""
     lam = Interval(y[:, n:])
     top = p.A - (p.J * Interval(lam.lo[:, :, None], lam.hi[:, :, None])).isum(axis=1)
     return Interval(np.hstack([top.lo, p.r.lo]), np.hstack([top.hi, p.r.hi]))
@@ -155,9 +157,8 @@ def _newton(land, lo: np.ndarray, hi: np.ndarray, spring: np.ndarray, n: int) ->
     evaluated as degenerate boxes; kept inside the box)."""
     y = 0.5 * (lo + hi)
     for _ in range(30):
-        g = _lagrange(land, y, spring, n).mid
         p = land.cone_parts(Interval(y[:, :n]), spring)
-        jac = _jacobian(p, Interval(y[:, n:])).mid
+        g, jac = _lagrange(p, y, n).mid, _jacobian(p, Interval(y[:, n:])).mid
         with np.errstate(all="ignore"):
             try:
                 step = np.linalg.solve(jac, g[..., None])[..., 0]

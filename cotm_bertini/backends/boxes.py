@@ -12,6 +12,10 @@ is not smooth at length 0. Each box is
 - set aside, where a spring may be shorter than `short` and the box is no wider than
   `min_width` undecided (without cone tests also where it is shorter over the whole box; the
   statement bounds the spring length over these boxes);
+- contracted, where the landscape can (`contract`: the spheres' bars along their pulls), to
+  the part that can hold a critical point, kept no thinner than THIN of its widest side and
+  off-centre (a halving line never through a symmetric point it was centred on); excluded
+  where nothing is left;
 - excluded, where the enclosure of some component of grad V misses 0 (a spring's term is
   enclosed through its cone too: finite where its length may be 0);
 - decided by the Krawczyk operator K(X) = m - Y g(m) + (I - Y H(X)) (X - m), Y the inverse of
@@ -53,6 +57,8 @@ NEAR_CONE = 10.0  # undecided where a spring may be shorter than this times SHOR
 NEAR_CONDITION = 1e10  # a critical point worth splitting below MIN_WIDTH for is no worse than this
 ROOT_FLOOR = 1e-10  # radians: boxes are not split below this, whatever a spring's length
 MAX_CUTS = 2  # sides halved at a split (see _split)
+THIN = 0.25  # a contracted box keeps each side at least this share of its widest (_inflated)
+SKEW = 0.0731  # of a contracted box's half width: its middle moved off a symmetric point
 KRAWCZYK_BATCH = 1024  # boxes for the Krawczyk test wait until this many are pending
 # landscape.free's codes: an angle V is flat along, or may be, or no critical point in the box
 FREE, EDGE, NONE = 2, 1, -1
@@ -83,6 +89,8 @@ class BoxLandscape(Protocol):
     # every element slack and no load), with the cables to take as slack there (`slack`, name
     # -> (B,) bool, for enclose(box, slack) and the states hessian reads); EDGE where that may
     # be so but is not proved; NONE where no critical point is in the box: see _step.
+    # Optional: `contract(box) -> (lo, hi)`, called right after `enclose(box)`: each box shrunk
+    # to a box that holds every critical point it holds (lo > hi: none).
 
 
 class BoxFamily(Protocol):
@@ -510,13 +518,8 @@ class _Part:
 def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, testing) -> _Outcome:
     """One batch: each box set aside, excluded, proved to hold one root, left, split, or (a
     box small enough for the Krawczyk test, where `testing` is False) handed back for it."""
-    box = Interval(lo, hi)
     rows = np.arange(len(lo))
-    dd, grad, states = land.enclose(box)
-    # Along free angles grad V is 0 whatever they are: the box is searched in the others.
-    code, slack = _free(land, box, states, grad)
-    if slack:  # those boxes' critical points have these cables slack: V as it is there
-        dd, grad, states = land.enclose(box, slack=slack)
+    dd, grad, states, code, slack, (lo, hi, gone) = _enclosed(land, Interval(lo, hi))
     free = code == FREE
     width = np.where(free, 0.0, hi - lo).max(axis=1)
     # At the edge of a free region (a node's cables may all be slack) every box holds
@@ -539,7 +542,8 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, testing) -
         which = np.where(smooth, which, shortest)
         near = (near | ~smooth) & ~aside & ~free.any(axis=1)
     decided, later = np.zeros(len(lo), dtype=bool), np.zeros(len(lo), dtype=bool)
-    test = np.flatnonzero(~aside & (smooth | cones))  # grad V enclosed through cones: finite
+    decided[gone] = True
+    test = np.flatnonzero(~aside & (smooth | cones) & ~gone)  # grad V finite through cones
     n = lo.shape[1]
     found = (rows[:0], np.zeros((0, n)), np.zeros((0, 2 * n)), np.zeros(0, dtype=bool))
     pieces = (rows[:0], np.zeros((0, 4 * n)))
@@ -587,6 +591,44 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, testing) -
         np.vstack([once[1], twice[1]])), np.concatenate([once[2], twice[2]]),
         rows[later], (lo[later], hi[later]), *pieces, rows[small & edge], *peaks,
     )  # fmt: skip
+
+
+def _enclosed(land: BoxLandscape, box: Interval) -> tuple:
+    """(dd, grad, states, code, slack, (lo, hi, gone)) of a batch: the enclosures, `free`'s
+    verdict (the enclosures redone with the cables it finds slack), the contracted boxes."""
+    dd, grad, states = land.enclose(box)
+    # Along free angles grad V is 0 whatever they are: the box is searched in the others.
+    code, slack = _free(land, box, states, grad)
+    if slack:  # those boxes' critical points have these cables slack: V as it is there
+        dd, grad, states = land.enclose(box, slack=slack)
+    return dd, grad, states, code, slack, _contracted(land, box)
+
+
+def _contracted(land: BoxLandscape, box: Interval) -> tuple:
+    """(lo, hi, gone): the boxes shrunk by the landscape's `contract` where it has one (to the
+    part that can hold a critical point; the enclosures over the whole box hold over it), and
+    which ones it emptied (left as they were: excluded)."""
+    rule = getattr(land, "contract", None)
+    if rule is None:
+        return box.lo, box.hi, np.zeros(len(box.lo), dtype=bool)
+    lo, hi = rule(box)
+    gone = (lo > hi).any(axis=1)
+    lo, hi = _inflated(lo, hi, box.lo, box.hi)
+    return np.where(gone[:, None], box.lo, lo), np.where(gone[:, None], box.hi, hi), gone
+
+
+def _inflated(lo, hi, outer_lo, outer_hi) -> tuple:
+    """Boxes (lo, hi) each side widened by a tenth of its width each way, and to at least THIN
+    times the widest side of its box `outer` (that it was contracted from), within that box:
+    K(X) inside X cannot be proved on a box thin in some side (a contraction can pin an angle
+    to rounding error) nor with the root on its edge (where a contraction may leave it), and
+    the widened box holds no critical point the contracted one does not. Its middle is moved
+    off the contracted box's (SKEW of its half width): a contraction can centre a box on a
+    symmetric critical point, and a halving would then put that point on an edge."""
+    floor = 0.5 * THIN * (outer_hi - outer_lo).max(axis=1, keepdims=True)
+    half = np.maximum(0.6 * (hi - lo), floor)
+    mid = 0.5 * (lo + hi) + SKEW * half
+    return np.maximum(outer_lo, mid - half), np.minimum(outer_hi, mid + half)
 
 
 def _tested(land, lo, hi, cand, states, free, slack) -> tuple:

@@ -15,7 +15,12 @@ pi (a symmetric pose on the edge of a box is never proved alone in it).
 
 V in chart angles: node positions X = parent + length u; grad V = J^T g, g the gradient in node
 coordinates from the generated first_order of the structure with every cable taut (each cable's
-force density enclosed as the torus route does, links.force_density); the Hessian is
+force density enclosed as the torus route does, links.force_density). A node's two components
+are length times u_a . G and u_b . G, G the pull on its bar end; since u_a and u_b are
+orthogonal to u they are also enclosed with each link's r taken without the node's own swing
+(a diagonal to the ground is then a constant vector), and the two enclosures are met. At a
+critical point G, and that swing-free pull F, lie along the bar: `contract` shrinks each box to
+the chart angles of the directions +-F/|F|. The Hessian is
 J^T H J + sum_i g_i d2X_i, H the generated Hessian with each cable's stiffness the interval [0, k]
 where the cable may be taut or slack over the box: H is linear in k, so that encloses the
 Hessian of every taut set the box allows (the hull the torus route forms set by set).
@@ -45,6 +50,7 @@ from .links import (
     found_endpoints,
     interval_sum,
     links,
+    meet,
     taut_groups,
 )
 
@@ -248,6 +254,48 @@ class SphereFramework:
                 out.append(i)
         return out
 
+    def swing_free_pull(self, dirs: list, i: int, ws: list) -> list:
+        """The pull of `pull` on node i, each link's r taken at the positions without node i's
+        own swing: u_a and u_b are orthogonal to u, so u_a . r is the same with or without it,
+        and r is enclosed without its widest term (a diagonal to the ground: a constant)."""
+        below = set(self.subtree(self.nodes[i]))
+        X = self.place(dirs, skip=i)
+        F = list(self._loads[3 * i : 3 * i + 3])
+        for k, w in enumerate(ws):
+            side = sum(s for j, s in self.ends[k] if j in below)
+            if not side:  # no end below node i, or both: no net pull on what hangs there
+                continue
+            r = [_total([self._offset[k][c]] + [s * X[3 * j + c] for j, s in self.ends[k]])
+                 for c in range(3)]  # fmt: skip
+            F = [f + (w * rc) * side for f, rc in zip(F, r, strict=True)]
+        return F
+
+    @property
+    def _offset(self) -> list[list[Interval]]:
+        """Each link's r at every node at the origin (its ground end's part): r = that + the
+        signed positions of its node ends (the stencil: +-1 on a node's coordinates)."""
+        return self._constants(tuple(self.P))[0]
+
+    @property
+    def _loads(self) -> list[Interval]:
+        """The loads' part of `pull` (minus the loads), three per node, summed down the chain."""
+        return self._constants(tuple(self.P))[1]
+
+    def _constants(self, key: tuple) -> tuple[list, list]:
+        """(_offset, _loads) from the generated code at the origin, enclosed, for the numbers
+        `key` (the generated code's parameters: renumber changes them)."""
+        if getattr(self, "_constants_of", (None,))[0] == key:
+            return self._constants_of[1]
+        count, per = 1, 3 + 3 * len(self.coords)
+        zero = [Interval(np.zeros(count))] * len(self.coords)
+        first = ball_module(self.full).first_order(self.pose(zero, count), self.P)
+        offset = [[Interval(np.zeros(1)) + first[k * per + c] for c in range(3)]
+                  for k in range(len(self.links))]  # fmt: skip
+        tail = [Interval(np.zeros(1)) + v for v in first[len(self.links) * per :]]
+        loads = [c for v in self.nodes for c in self.pull(tail, v)]
+        self._constants_of = (key, (offset, loads))
+        return offset, loads
+
     def pull(self, g: list, node: str) -> list:
         """The force on `node`'s bar end: the gradient (in node coordinates) of every node
         hanging from it, summed (three components)."""
@@ -256,18 +304,26 @@ class SphereFramework:
     def kinematics(self, x, second: bool = True) -> tuple[list, list]:
         """(positions: three per node, directions per node, with their second derivatives if
         `second`) at boxes (Interval) or points."""
-        dirs, pos = [], {}
+        dirs = [directions(x[:, 2 * i], x[:, 2 * i + 1], second) for i in range(len(self.nodes))]
+        return self.place(dirs), dirs
+
+    def place(self, dirs: list, skip: int | None = None) -> list:
+        """Node coordinates (three per node) from each node's direction; with `skip`, that
+        node's own swing (length times u) left out of its position and of every node's below."""
+        pos: dict[str, list] = {}
         for i, v in enumerate(self.nodes):
-            d = directions(x[:, 2 * i], x[:, 2 * i + 1], second)
             top = self.parent[v]
             if owner(top) == "ground":
                 g = top.split(".", 1)[1]
                 base = [self.slots[f"g_{g}_{c}"] for c in "xyz"]
             else:
                 base = pos[top]
-            pos[v] = [b + self.length[v] * u for b, u in zip(base, d["u"], strict=True)]
-            dirs.append(d)
-        return [c for v in self.nodes for c in pos[v]], dirs
+            pos[v] = (
+                list(base)
+                if i == skip
+                else [b + self.length[v] * u for b, u in zip(base, dirs[i]["u"], strict=True)]
+            )
+        return [c for v in self.nodes for c in pos[v]]
 
     def pose(self, positions: list, count: int) -> list:
         """The generated code's arguments: the node coordinates, the rest 0 (read by nothing)."""
@@ -277,12 +333,13 @@ class SphereFramework:
         return X
 
     def node_gradient(self, positions: list, count: int, slack: dict | None = None):
-        """(g in node coordinates, squared lengths per link, cable states) over boxes; the
+        """(g in node coordinates, squared lengths per link, cable states, force densities per
+        link) over boxes; the
         cables of `slack` (name: (B,) bool) taken slack where it says so (see `free`)."""
         first = ball_module(self.full).first_order(self.pose(positions, count), self.P)
         m, per = len(positions), 3 + 3 * len(positions)
         g = [Interval(np.zeros(count)) + v for v in first[len(self.links) * per :]]
-        dds, states = [], {}
+        dds, states, ws = [], {}, []
         for i, x in enumerate(self.links):
             r, dr = first[i * per : i * per + 3], first[i * per + 3 : (i + 1) * per]
             dd = interval_sum(Interval.of(c) * c for c in r)
@@ -299,7 +356,8 @@ class SphereFramework:
                 if terms:
                     g[j] = g[j] + interval_sum(terms)
             dds.append(dd)
-        return g, dds, states
+            ws.append(w)
+        return g, dds, states, ws
 
     def enclose(self, box: Interval, slack: dict | None = None) -> tuple:
         """(squared lengths of the free-length springs, grad V in chart angles, cable states),
@@ -307,15 +365,37 @@ class SphereFramework:
         count = box.lo.shape[0]
         positions, dirs = self.kinematics(box, second=False)
         self._last = (box.lo, positions, dirs)  # for `free`, called next on the same box
-        g, dds, states = self.node_gradient(positions, count, slack)
-        grad = []
+        g, dds, states, ws = self.node_gradient(positions, count, slack)
+        grad, pulls = [], []
         for i, v in enumerate(self.nodes):
-            G = self.pull(g, v)
-            grad += [self.length[v] * _dot(dirs[i][key], G) for key in ("ua", "ub")]
+            G, F = self.pull(g, v), self.swing_free_pull(dirs, i, ws)
+            grad += [meet(_dot(dirs[i][key], G), _dot(dirs[i][key], F)) * self.length[v]
+                     for key in ("ua", "ub")]  # fmt: skip
+            pulls.append(F)
+        self._pulls = (box.lo, pulls)  # for `contract`, called next on the same box
         springs = [dd for x, dd in zip(self.links, dds, strict=True) if x.L0 is not None
                    and not x.cable]  # fmt: skip
         lengths = stack(springs, axis=1) if springs else Interval(np.zeros((count, 0)))
         return lengths, stack(grad, axis=1), states
+
+    def contract(self, box: Interval) -> tuple[np.ndarray, np.ndarray]:
+        """(lo, hi) of each box shrunk to where a critical point can be (lo > hi somewhere:
+        none), from the pulls `enclose` just found over it. At a critical point each node's
+        pull G (on its bar end, from everything hanging there) is along the bar, and so is the
+        swing-free pull F = G - c u (`swing_free_pull`): u = +-F / |F|, and where F's
+        enclosure misses 0 that confines the node's two chart angles (_directions_along)."""
+        lo, hi = box.lo.copy(), box.hi.copy()
+        at, pulls = getattr(self, "_pulls", (None, None))
+        if at is not box.lo:
+            raise ValueError("contract wants the boxes that enclose saw last")
+        for i, G in enumerate(pulls):
+            a, b = slice(2 * i, 2 * i + 1), slice(2 * i + 1, 2 * i + 2)
+            (a_lo, a_hi), (b_lo, b_hi) = _directions_along(
+                G, lo[:, a][:, 0], hi[:, a][:, 0], lo[:, b][:, 0], hi[:, b][:, 0]
+            )
+            lo[:, 2 * i], hi[:, 2 * i] = a_lo, a_hi
+            lo[:, 2 * i + 1], hi[:, 2 * i + 1] = b_lo, b_hi
+        return lo, hi
 
     def jacobian(self, dirs: list, count: int) -> list:
         """dX/d(angles) as rows (3 per node) of columns (2 per node): Intervals or arrays."""
@@ -332,7 +412,7 @@ class SphereFramework:
         """A slope matrix of grad V over each box (B, n, n) (module docstring)."""
         count = box.lo.shape[0]
         positions, dirs = self.kinematics(box)
-        g, _, _ = self.node_gradient(positions, count, _slack_of(states))
+        g = self.node_gradient(positions, count, _slack_of(states))[0]
         H = self.node_hessian(positions, count, states)
         J = stack([stack(row, axis=1) for row in self.jacobian(dirs, count)], axis=1)
         JT = Interval(np.swapaxes(J.lo, 1, 2), np.swapaxes(J.hi, 1, 2))
@@ -537,6 +617,58 @@ class SphereFramework:
             else:
                 raise ValueError(f"the real route has no value for unknown {v}")
         return found_endpoints(fs.ps.variables, values, np.arange(len(X)))
+
+
+def _directions_along(G: list, a_lo, a_hi, b_lo, b_hi) -> tuple:
+    """The chart angles (a, b) of a box (each (B,) lo and hi) shrunk to the directions u =
+    +-G/|G| (G three Intervals (B,)): ((a lo, a hi), (b lo, b hi)), lo > hi where neither
+    direction is in the box; the box as it was where G may be 0 or is not finite. In chart A
+    a = acos(u_z) and b is the argument of u_x + i u_y; chart B is A with (x, y, z) -> (z, x, y)
+    (`directions`)."""
+    norm = interval_sum([c.square() for c in G]).sqrt()
+    ok = (norm.lo > 0) & np.isfinite(norm.hi) & np.all([c.finite() for c in G], axis=0)
+    safe = Interval(np.where(ok, norm.lo, 1.0), np.where(ok, norm.hi, 1.0))
+    U = [Interval(np.clip(q.lo, -1, 1), np.clip(q.hi, -1, 1)) for q in (c / safe for c in G)]
+    turned = a_lo >= SHIFT / 2
+    shift = np.where(turned, SHIFT, 0.0)
+    # chart A: (axis, plane x, plane y) = (z, x, y); chart B: (x, y, z)
+    axis = Interval.where(turned, U[0], U[2])
+    px, py = Interval.where(turned, U[1], U[0]), Interval.where(turned, U[2], U[1])
+    outs = []
+    for sign in (1.0, -1.0):
+        z, x, y = axis * sign, px * sign, py * sign
+        # acos is decreasing; libm's acos is within an ulp or two: padded
+        lo_a = np.arccos(np.clip(z.hi, -1, 1)) - 1e-15 + shift
+        hi_a = np.arccos(np.clip(z.lo, -1, 1)) + 1e-15 + shift
+        outs.append(((np.maximum(a_lo, lo_a), np.minimum(a_hi, hi_a)),
+                     _arguments(x, y, b_lo, b_hi)))  # fmt: skip
+    (a1, b1), (a2, b2) = outs
+    empty1 = (a1[0] > a1[1]) | (b1[0] > b1[1])
+    empty2 = (a2[0] > a2[1]) | (b2[0] > b2[1])
+    out = []
+    for p, q, keep in ((a1, a2, (a_lo, a_hi)), (b1, b2, (b_lo, b_hi))):
+        lo = np.where(empty1, q[0], np.where(empty2, p[0], np.minimum(p[0], q[0])))
+        hi = np.where(empty1, q[1], np.where(empty2, p[1], np.maximum(p[1], q[1])))
+        out.append((np.where(ok, lo, keep[0]), np.where(ok, hi, keep[1])))
+    return tuple(out)
+
+
+def _arguments(x: Interval, y: Interval, b_lo, b_hi) -> tuple[np.ndarray, np.ndarray]:
+    """[b lo, b hi] shrunk to the arguments of x + i y over the box (x, y); unchanged where the
+    box is half a turn or wider or (x, y) may be 0, lo > hi where none lies in [b lo, b hi]."""
+    mid = 0.5 * (b_lo + b_hi)
+    c, s = Interval(mid).cos(), Interval(mid).sin()
+    p, q = x * c + y * s, y * c - x * s  # x + i y turned by -mid: its argument less mid
+    narrow = (b_hi - b_lo) < math.pi - 1e-9  # within (mid - pi/2, mid + pi/2)
+    behind = p.hi <= 0  # every argument at least pi/2 from mid: none in the box
+    around = p.contains_zero() & q.contains_zero()
+    corners = np.stack([np.arctan2(q_, p_) for p_ in (p.lo, p.hi) for q_ in (q.lo, q.hi)])
+    lo = mid + corners.min(axis=0) - 1e-12  # arctan2 is not correctly rounded: padded
+    hi = mid + corners.max(axis=0) + 1e-12
+    use = narrow & ~around & ~behind
+    lo, hi = np.where(use, np.maximum(b_lo, lo), b_lo), np.where(use, np.minimum(b_hi, hi), b_hi)
+    gone = narrow & behind
+    return np.where(gone, 1.0, lo), np.where(gone, 0.0, hi)
 
 
 def _link_block(x, r: Interval, state=None) -> Interval:

@@ -209,6 +209,7 @@ class SphereFramework:
         pull is the gradient of |r|^2 / 2 there: +-r (its end below node i) along u_a, u_b."""
         per, v = 3 + 3 * len(self.coords), self.nodes[i]
         below = set(self.subtree(v))
+        free_of = self.place(dirs, skip=i)
         pulls = []
         for k, x in enumerate(self.links):
             on = states[x.name][at] != SLACK if x.name in cables else None
@@ -216,8 +217,10 @@ class SphereFramework:
                 continue
             sign = next(sg for j, sg in self.ends[k] if j in below)
             r = [_rows_of(first[k * per + c], loc) for c in range(3)]
+            q = [_rows_of(c, loc) for c in self.link_vector(free_of, k)]  # r less the swing
             u = {key: [_rows_of(dirs[i][key][c], loc) for c in range(3)] for key in ("ua", "ub")}
-            pull = [_dot(u[key], r) * (sign * self.length[v]) for key in ("ua", "ub")]
+            pull = [meet(_dot(u[key], r), _dot(u[key], q)) * (sign * self.length[v])
+                    for key in ("ua", "ub")]  # fmt: skip
             pulls.append((on, pull))
         if not pulls:
             return np.ones(len(loc), dtype=bool)
@@ -265,10 +268,17 @@ class SphereFramework:
             side = sum(s for j, s in self.ends[k] if j in below)
             if not side:  # no end below node i, or both: no net pull on what hangs there
                 continue
-            r = [_total([self._offset[k][c]] + [s * X[3 * j + c] for j, s in self.ends[k]])
-                 for c in range(3)]  # fmt: skip
-            F = [f + (w * rc) * side for f, rc in zip(F, r, strict=True)]
+            F = [f + (w * rc) * side for f, rc in zip(F, self.link_vector(X, k), strict=True)]
         return F
+
+    def link_vector(self, X: list, k: int) -> list:
+        """Link k's r (three components) at node coordinates X, from its ends' signs and its
+        ground end (`_offset`): X may leave a node's swing out (`place`), the generated code's
+        r cannot."""
+        ends = self.ends[k]
+        return [
+            _total([self._offset[k][c]] + [s * X[3 * j + c] for j, s in ends]) for c in range(3)
+        ]
 
     @property
     def _offset(self) -> list[list[Interval]]:
@@ -705,9 +715,9 @@ def _link_block(x, r: Interval, state=None) -> Interval:
 def _rows_of(v, loc: np.ndarray) -> Interval:
     """Rows `loc` of a generated value over boxes (an Interval, or a constant for them all)."""
     if isinstance(v, Interval):
-        return (
-            v[loc] if np.ndim(v.lo) else Interval(np.full(len(loc), v.lo), np.full(len(loc), v.hi))
-        )
+        if np.ndim(v.lo) and len(v.lo) > 1:
+            return v[loc]
+        return Interval(np.full(len(loc), v.lo.ravel()[0]), np.full(len(loc), v.hi.ravel()[0]))
     return Interval(np.full(len(loc), float(v)))
 
 

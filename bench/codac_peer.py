@@ -64,6 +64,9 @@ EXAMPLES = {
     "chain3": ROOT / "examples" / "chain3.toml",
     "chain3_collapse": ROOT / "tests" / "fixtures" / "chain3_collapse.toml",
 }
+SPHERES = {"prism_slack": ROOT / "examples" / "prism_slack.toml"}  # in chart angles
+CHART_B = 8.0  # backends.spheres: chart B's first angle is stored 8 higher (a box says its chart)
+POSE_TOL = 1e-3  # length units: codac clusters (and our roots) at poses this close are one
 CHECK_POINTS = 20  # random angle vectors at which grad V is compared with the package's
 CHECK_TOL = 1e-9  # largest allowed difference, relative to max(1, |grad V|)
 CONE = 1e-2  # length units: a codac cluster whose hull's middle has a spring this short is at
@@ -198,6 +201,112 @@ def _expr(e: sp.Expr, names: dict):
     raise ValueError(f"no codac form for {type(e).__name__}: {e}")
 
 
+def sphere_gradient(fw: Framework, turned: tuple[bool, ...]) -> tuple[Gradient, list]:
+    """(grad V in chart angles a_i, b_i of each free node, the nodes' positions as sympy
+    expressions) of a spatial framework whose nodes hang by bars, each node in chart A (u =
+    (sin a cos b, sin a sin b, cos a)) or, where `turned`, chart B (u = (cos a', sin a' cos b,
+    sin a' sin b), a' = a - CHART_B): written from the charts' definitions, not the package."""
+    slots = fw.slots()
+    nodes = list(fw.nodes)
+    angles = list(sp.symbols(f"t0:{2 * len(nodes)}", real=True))
+    pos: dict[str, list] = {}
+    for g in {p.split(".", 1)[1] for x in fw.links for p in (x.a, x.b) if owner(p) == "ground"}:
+        pos[f"ground.{g}"] = [sp.Float(slots[f"g_{g}_{c}"]) for c in "xyz"]
+    bars = [x for x in fw.links if x.kind == "bar"]
+    while len(pos) < len(nodes) + sum(p.startswith("ground.") for p in pos):
+        for x in bars:
+            for top, node in ((x.a, x.b), (x.b, x.a)):
+                if top in pos and node in nodes and node not in pos:
+                    i = nodes.index(node)
+                    a, b = angles[2 * i], angles[2 * i + 1]
+                    if turned[i]:
+                        a = a - CHART_B
+                        u = [sp.cos(a), sp.sin(a) * sp.cos(b), sp.sin(a) * sp.sin(b)]
+                    else:
+                        u = [sp.sin(a) * sp.cos(b), sp.sin(a) * sp.sin(b), sp.cos(a)]
+                    length = slots[f"len_{x.name}"]
+                    pos[node] = [p + length * c for p, c in zip(pos[top], u, strict=True)]
+    V, spring_dd = sp.Integer(0), []
+    for x in (x for x in fw.links if x.kind != "bar"):
+        r = [p - q for p, q in zip(pos[x.a], pos[x.b], strict=True)]
+        dd = sum(c**2 for c in r)
+        k, L0 = slots[f"k_{x.name}"], slots[f"L0_{x.name}"]
+        stretch = sp.sqrt(dd) - L0
+        V += k / 2 * (sp.Max(stretch, 0) ** 2 if x.kind == "cable" else stretch**2)
+        if x.kind != "cable" and L0 != 0:
+            spring_dd.append(dd)
+    for load in fw.loads:
+        at = pos[load.point]
+        V -= sum(slots[f"f_{load.name}_{c}"] * p for c, p in zip("xyz", at, strict=True))
+    grad = [sp.diff(V, t).replace(sp.Heaviside, lambda *a: sp.Integer(1)) for t in angles]
+    return Gradient(angles, grad, spring_dd), [c for v in nodes for c in pos[v]]
+
+
+def sphere_row(name: str, budgets: tuple[float, float]) -> dict:
+    """prism_slack by both solvers over the search's chart boxes (27: each node's band and two
+    caps): codac paves each box with the gradient of its charts; roots compared by pose (a pose
+    in two overlapping charts is one)."""
+    fw = cb.Framework.from_toml(SPHERES[name])
+    land = landscape(fw)
+    lo, hi = land.domain(0)
+    length, stiffness = units(fw)
+    found, boxes, seconds, left, err, n = [], 0, 0.0, [], 0.0, lo.shape[1]
+    cache: dict = {}
+    # Most chart boxes are emptied in seconds: each first gets an equal share of a tenth of the
+    # budget, and those it does not finish are paved again from the start, in turn, each with
+    # all the budget left (prism_slack: one chart box, every node in the band, holds the roots).
+    todo, again = [(a, b, True) for a, b in zip(lo, hi, strict=True)], []
+    while todo or again:
+        b_lo, b_hi, early = todo.pop(0) if todo else (*again.pop(0), False)
+        budget = budgets[0] / 10 / len(lo) if early else budgets[0] - seconds
+        turned = tuple(bool(v >= CHART_B / 2) for v in b_lo[0::2])
+        if turned not in cache:
+            g, X = sphere_gradient(fw, turned)
+            x = b_lo + np.random.default_rng(1).random((CHECK_POINTS, n)) * (b_hi - b_lo)
+            theirs = land.derivatives(x)[0] * stiffness * length**2
+            ours = numeric(g)(x)
+            scale = np.maximum(1.0, np.abs(theirs).max(axis=1, keepdims=True))
+            err = max(err, float((np.abs(ours - theirs) / scale).max()))
+            cache[turned] = (g, sp.lambdify(g.angles, X, "numpy"))
+        g, place = cache[turned]
+        f = run_codac(g, MIN_WIDTH, budget, box=(b_lo, b_hi))
+        boxes, seconds = boxes + f.boxes, seconds + f.seconds
+        if f.complete:
+            found += [np.array(place(*x), dtype=float) for x in f.roots]
+        elif early:
+            again.append((b_lo, b_hi))
+        else:
+            left.append(f.note)
+    if err > CHECK_TOL:
+        raise SystemExit(f"{name}: grad V differs from the package's by {err:.2e}")
+    t0 = time.perf_counter()
+    ours = search(land, SHORT, MIN_WIDTH, max_seconds=budgets[1])
+    ours_s = time.perf_counter() - t0
+    ours_pose = land.positions(ours.roots) * length
+    theirs_pose = _distinct_poses(np.array(found).reshape(-1, 3 * len(fw.nodes)))
+    gap = np.abs(theirs_pose[:, None, :] - ours_pose[None, :, :]).max(axis=2)
+    matched = int((gap.min(axis=1) < POSE_TOL).sum()) if gap.size else 0
+    done = not left and not ours.budget_hit
+    return {"example": name + " (chart angles)", "n": n, "grad_check": err,
+            "codac_roots": len(theirs_pose), "ours_roots": len(ours.roots), "codac_boxes": boxes,
+            "ours_boxes": ours.boxes, "codac_s": seconds, "ours_s": ours_s,
+            "codac_over_ours": seconds / ours_s,
+            "agree": ("yes" if matched == len(theirs_pose) == len(ours.roots) else "no")
+            if done else "partial: a budget hit",
+            "codac_matched": matched,
+            "notes": f"codac: {len(found)} clusters over 27 chart boxes, {len(theirs_pose)} poses"
+            + "".join(f"; a chart box stopped: {note}" for note in left)}  # fmt: skip
+
+
+def _distinct_poses(X: np.ndarray) -> np.ndarray:
+    """The poses (R, 3 m) each once: those within POSE_TOL of an earlier one left out."""
+    kept: list[np.ndarray] = []
+    for p in X:
+        if all(np.abs(p - q).max() >= POSE_TOL for q in kept):
+            kept.append(p)
+    return np.array(kept).reshape(-1, X.shape[1])
+
+
 @dataclass
 class Found:
     """One solver's outcome over the domain."""
@@ -211,16 +320,18 @@ class Found:
     complete: bool = True  # the whole domain decided (no budget hit)
 
 
-def run_codac(g: Gradient, eps: float, budget: float, fixpoint: bool = False) -> Found:
+def run_codac(g: Gradient, eps: float, budget: float, fixpoint: bool = False,
+              box: tuple | None = None) -> Found:  # fmt: skip
     """codac's `pave` loop (codac2_pave.cpp: first in, first out; contract; drop an empty box,
     keep one no wider than eps, else bisect it), written here around CtcInverse(grad V, 0) so
     that it stops at `budget` seconds (wall) with the boxes left counted as undecided; the kept
-    boxes grouped into clusters (`clusters`)."""
+    boxes grouped into clusters (`clusters`). `box`: (lo, hi) to pave, else the torus."""
     f, _ = to_codac(g)
     ctc = codac.CtcInverse(f, codac.IntervalVector([[0.0, 0.0]] * g.n))
     if fixpoint:
         ctc = codac.CtcFixpoint(ctc)
-    todo = deque([codac.IntervalVector([[OFFSET, OFFSET + TWO_PI]] * g.n)])
+    start = [[OFFSET, OFFSET + TWO_PI]] * g.n if box is None else list(zip(*box, strict=True))
+    todo = deque([codac.IntervalVector([[float(a), float(b)] for a, b in start])])
     kept, calls, inside = [], 0, 0.0
     t0 = time.perf_counter()
     while todo:
@@ -392,7 +503,8 @@ def row(name: str, budgets: tuple[float, float], fixpoint: bool) -> dict:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--only", nargs="*", default=list(EXAMPLES), choices=list(EXAMPLES))
+    names = list(EXAMPLES) + list(SPHERES)
+    ap.add_argument("--only", nargs="*", default=names, choices=names)
     ap.add_argument("--codac-budget", type=float, default=180.0, help="seconds, each example")
     ap.add_argument("--ours-budget", type=float, default=60.0, help="seconds, each example")
     ap.add_argument("--fixpoint", action="store_true", help="codac: CtcFixpoint(CtcInverse)")
@@ -403,7 +515,9 @@ def main() -> None:
         f"({codac.nb_threads()} thread), numpy {np.__version__}"
     )
     budgets = (args.codac_budget, args.ours_budget)
-    frame = pd.DataFrame([row(name, budgets, args.fixpoint) for name in args.only])
+    rows = [sphere_row(name, budgets) if name in SPHERES else row(name, budgets, args.fixpoint)
+            for name in args.only]  # fmt: skip
+    frame = pd.DataFrame(rows)
     kind = "CtcFixpoint(CtcInverse)" if args.fixpoint else "CtcInverse"
     show(f"codac (pave loop, {kind}, eps {MIN_WIDTH:g}) against the real route's search "
          f"(SHORT {SHORT:g}, MIN_WIDTH {MIN_WIDTH:g})", frame,

@@ -344,8 +344,8 @@ class SphereFramework:
 
     def node_gradient(self, positions: list, count: int, slack: dict | None = None):
         """(g in node coordinates, squared lengths per link, cable states, force densities per
-        link) over boxes; the
-        cables of `slack` (name: (B,) bool) taken slack where it says so (see `free`)."""
+        link) over boxes; the cables of `slack` (name: (B,) bool) taken slack where it says so
+        (see `free`)."""
         first = ball_module(self.full).first_order(self.pose(positions, count), self.P)
         m, per = len(positions), 3 + 3 * len(positions)
         g = [Interval(np.zeros(count)) + v for v in first[len(self.links) * per :]]
@@ -647,9 +647,10 @@ def _directions_along(G: list, a_lo, a_hi, b_lo, b_hi) -> tuple:
     outs = []
     for sign in (1.0, -1.0):
         z, x, y = axis * sign, px * sign, py * sign
-        # acos is decreasing; libm's acos is within an ulp or two: padded
-        lo_a = np.arccos(np.clip(z.hi, -1, 1)) - 1e-15 + shift
-        hi_a = np.arccos(np.clip(z.lo, -1, 1)) + 1e-15 + shift
+        # acos is decreasing; libm's acos (an ulp or two) and the shift's addition (half an
+        # ulp of 11) are not exact: padded
+        lo_a = np.arccos(np.clip(z.hi, -1, 1)) - 1e-14 + shift
+        hi_a = np.arccos(np.clip(z.lo, -1, 1)) + 1e-14 + shift
         outs.append(((np.maximum(a_lo, lo_a), np.minimum(a_hi, hi_a)),
                      _arguments(x, y, b_lo, b_hi)))  # fmt: skip
     (a1, b1), (a2, b2) = outs

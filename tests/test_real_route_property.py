@@ -348,3 +348,30 @@ def test_the_solve_report_names_each_cone_point():
     lines = [ln for ln in res.record["summary"].splitlines() if ln.startswith("cone point ")]
     assert len(lines) == 2 and all("spring s2 at zero length" in ln for ln in lines)
     assert all("< k L0 = 2.7" in ln and "index 2" in ln for ln in lines)
+
+
+def test_a_moved_spheres_landscape_encloses_as_a_new_one_does():
+    """Continuation moves a spheres landscape to other numbers (real_route.moved_landscape):
+    its enclosures and contraction, which read constants off the generated code, must be those
+    of a landscape built anew at the new numbers (a stale constant would shift every pull)."""
+    from cotm_bertini.backends.boxes import _contracted
+    from cotm_bertini.backends.real_route import moved_landscape, new_landscape
+    from cotm_bertini.model.framework.units import normalized_slots
+    from cotm_bertini.model.intervals import Interval
+
+    fw = cb.Framework.from_toml(ROOT / "tests" / "fixtures" / "prism_saddle.toml")
+    land = new_landscape(fw)
+    lo, hi = land.domain(0)
+    land.enclose(Interval(lo, hi))  # the constants read at the old numbers
+    other = fw.replace(**{name: 1.1 * value for name, value in fw.values.items()})
+    moved, fresh = moved_landscape(land, other, normalized_slots(other)), new_landscape(other)
+    rng = np.random.default_rng(3)
+    x = lo + rng.random(lo.shape) * (hi - lo)
+    box = Interval(x - 0.05, x + 0.05)
+    for a, b in zip(moved.enclose(box)[:2], fresh.enclose(box)[:2], strict=True):
+        assert np.array_equal(a.lo, b.lo) and np.array_equal(a.hi, b.hi)
+    moved.enclose(box)
+    got = _contracted(moved, box)
+    fresh.enclose(box)
+    want = _contracted(fresh, box)
+    assert all(np.array_equal(p, q) for p, q in zip(got, want, strict=True))

@@ -136,6 +136,7 @@ class SphereFramework:
         """The numbers taken from normalised `slots` (default: the framework's): the
         generated code's parameters, links, bar lengths."""
         self.slots = normalized_slots(self.fw) if slots is None else slots
+        self.__dict__.pop("_constants", None)  # numbers read off the generated code
         self.P = [float(v) for v in slot_vector(self.slots)]
         self.links = links(self.fw, self.full.active, self.slots)
         self.length = {n: self.slots[f"len_{bar}"] for n, _, bar in self.chain}
@@ -263,7 +264,7 @@ class SphereFramework:
         and r is enclosed without its widest term (a diagonal to the ground: a constant)."""
         below = set(self.subtree(self.nodes[i]))
         X = self.place(dirs, skip=i)
-        F = list(self._loads[3 * i : 3 * i + 3])
+        F = list(self._constants[1][3 * i : 3 * i + 3])
         for k, w in enumerate(ws):
             side = sum(s for j, s in self.ends[k] if j in below)
             if not side:  # no end below node i, or both: no net pull on what hangs there
@@ -273,38 +274,23 @@ class SphereFramework:
 
     def link_vector(self, X: list, k: int) -> list:
         """Link k's r (three components) at node coordinates X, from its ends' signs and its
-        ground end (`_offset`): X may leave a node's swing out (`place`), the generated code's
-        r cannot."""
-        ends = self.ends[k]
-        return [
-            _total([self._offset[k][c]] + [s * X[3 * j + c] for j, s in ends]) for c in range(3)
-        ]
+        ground end (`_constants`): X may leave a node's swing out (`place`), the generated
+        code's r cannot."""
+        ends, offset = self.ends[k], self._constants[0][k]
+        return [_total([offset[c]] + [s * X[3 * j + c] for j, s in ends]) for c in range(3)]
 
-    @property
-    def _offset(self) -> list[list[Interval]]:
-        """Each link's r at every node at the origin (its ground end's part): r = that + the
-        signed positions of its node ends (the stencil: +-1 on a node's coordinates)."""
-        return self._constants(tuple(self.P))[0]
-
-    @property
-    def _loads(self) -> list[Interval]:
-        """The loads' part of `pull` (minus the loads), three per node, summed down the chain."""
-        return self._constants(tuple(self.P))[1]
-
-    def _constants(self, key: tuple) -> tuple[list, list]:
-        """(_offset, _loads) from the generated code at the origin, enclosed, for the numbers
-        `key` (the generated code's parameters: renumber changes them)."""
-        if getattr(self, "_constants_of", (None,))[0] == key:
-            return self._constants_of[1]
+    @cached_property
+    def _constants(self) -> tuple[list, list]:
+        """(each link's r at every node at the origin: its ground end's part, so that r = that
+        + the signed positions of its node ends; the loads' part of `pull`, three per node,
+        summed down the chain) from the generated code, enclosed (dropped by `renumber`)."""
         count, per = 1, 3 + 3 * len(self.coords)
         zero = [Interval(np.zeros(count))] * len(self.coords)
         first = ball_module(self.full).first_order(self.pose(zero, count), self.P)
         offset = [[Interval(np.zeros(1)) + first[k * per + c] for c in range(3)]
                   for k in range(len(self.links))]  # fmt: skip
         tail = [Interval(np.zeros(1)) + v for v in first[len(self.links) * per :]]
-        loads = [c for v in self.nodes for c in self.pull(tail, v)]
-        self._constants_of = (key, (offset, loads))
-        return offset, loads
+        return offset, [c for v in self.nodes for c in self.pull(tail, v)]
 
     def pull(self, g: list, node: str) -> list:
         """The force on `node`'s bar end: the gradient (in node coordinates) of every node

@@ -333,7 +333,10 @@ FRAMEWORK_EVENTS = {
     "branches": "the branch ids of the rows involved (a+b; a+b+c at a pitchfork, the third "
     "branch among them) at the neighbouring sweep point where they exist: its physical rows "
     "nearest in pose to the event",
-    "<param>": "the event's parameter value: the middle of the final bisection bracket; of a "
+    "<param>": "the event's parameter value: of a fold on the real route, the solution of the "
+    "fold system (grad V = 0, H v = 0) Newton converged to from the pair that meets there (its "
+    "bracket then proved by one complete solve on each side); else the middle of the final "
+    "bisection bracket; of a "
     "fold the probes could not close in on (the solver sees the merging pair as one degenerate "
     "root or leaves it undecided), the zero of the parabola through three probes of the merging "
     "pair's eigenvalue product; of a cable switch, where the followed equilibrium's cable "
@@ -351,7 +354,9 @@ FRAMEWORK_EVENTS = {
     "a probe that sees the event itself (counts matching neither end, with a degenerate row or "
     "a failed check: at a fold, the merging pair taken as one root) places no end; a cable "
     "switch: also its secant converged",
-    "bracket": "the value's accuracy: the final bisection bracket's width (1e-9 relative, or as "
+    "bracket": "the value's accuracy: the width between the complete solves on either side of "
+    "it (a located fold: 1e-9 relative, wider only where a solve that near sees the pair as one "
+    "root); the final bisection bracket's width (1e-9 relative, or as "
     "narrow as the probes that see the event allow); of an extrapolated fold, the parabola's "
     "zero's distance from the line's through the two nearest probes; of a cable switch or a "
     "cone point, the secant's next step on d - L0 of its cable or on pull - k L0 (converged to "

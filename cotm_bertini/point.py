@@ -440,7 +440,7 @@ def _solve_real(
     `found`: the landscape (_real_landscape) and its search, where already made."""
     from .analysis.framework_checks import completeness, framework_counts, order_rows
     from .analysis.framework_continua import absorb, continuum_record, find_continua
-    from .backends.box_shares import split_search
+    from .backends.box_shares import deepened, split_search
     from .backends.boxes import SHORT
     from .backends.real_route import landscape
     from .model.framework.units import units
@@ -452,6 +452,7 @@ def _solve_real(
             found = split_search(landscape, fw, SHORT, MIN_WIDTH, workers=settings.workers,
                                  scheduler=settings.scheduler, max_seconds=settings.timeout,
                                  label=f"real search of {fw.name}")  # fmt: skip
+        found = deepened(land, found, SHORT, MIN_WIDTH, f"real search of {fw.name}")
         seeds, descents, regions = _unproved(land, found, unit, settings.seed)
         groups = land.endpoints(np.vstack([found.roots, seeds]))
     report: dict = {" ".join(taut) or "none": {"excluded": True, "pruned": "bound smoothing",

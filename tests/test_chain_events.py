@@ -271,3 +271,22 @@ def test_two_events_between_neighbouring_points_are_both_found(tmp_path):
         assert _angle_gap(pose, _middle(born)) < np.radians(1e-4)
     stable = events[events["kind"] == "stability_change"]
     assert abs(stable["L01"].iloc[0] - expected[0][0]) < 1e-6
+
+
+def test_a_fold_is_located_on_its_system_and_proved_by_two_solves(tmp_path, monkeypatch):
+    """Between the sweep points LO and HI the fold is located by Newton on the fold system
+    (grad V = 0, H v = 0) from the pair that meets there, then proved by one full solve on each
+    side of it, 1e-9 apart: two solves, not a bisection's thirty; at the independent value."""
+    import cotm_bertini.point as point
+
+    calls = []
+    solve = point.solve_framework_point
+    monkeypatch.setattr(
+        point, "solve_framework_point", lambda *a, **k: calls.append(1) or solve(*a, **k)
+    )
+    code, events, _ = _sweep(tmp_path, LO, HI, 2)
+    assert code == 0
+    fold = events[events["kind"] == "fold"]
+    assert len(fold) == 1 and len(calls) == 2, events.to_string()
+    assert bool(fold["refined"].iloc[0]) and fold["bracket"].iloc[0] < 2e-9
+    assert abs(fold["L01"].iloc[0] - _fold(LO, HI, _minima)) < 1e-6

@@ -375,3 +375,22 @@ def test_a_moved_spheres_landscape_encloses_as_a_new_one_does():
     fresh.enclose(box)
     want = _contracted(fresh, box)
     assert all(np.array_equal(p, q) for p, q in zip(got, want, strict=True))
+
+
+@pytest.mark.parametrize("name", ["tests/fixtures/zeeman_sphere.toml", "examples/prism_slack.toml",
+                                  "tests/fixtures/chain4.toml"])  # fmt: skip
+def test_a_table_s_rows_are_read_back_as_chart_points_at_their_poses(name):
+    """landscape.chart_points (a sweep's fold is located from a table's rows): each row of a
+    solve read back into chart angles is at the row's pose and is a critical point there."""
+    from cotm_bertini.backends.real_route import landscape
+    from cotm_bertini.model.framework.spec import units
+
+    fw = cb.Framework.from_toml(ROOT / name)
+    res = cb.solve(fw, cache=False)
+    land = landscape(fw)
+    theta = land.chart_points({c: res.table[c].to_numpy() for c in res.table})
+    assert len(theta) == len(res.table) and np.abs(land.derivatives(theta)[0]).max() < 1e-9
+    if hasattr(land, "positions"):  # the node positions (a torus's angles are the columns')
+        names = [f"{v}.{c}" for v in land.nodes for c in "xyz"]
+        X = res.table[names].to_numpy(float) / units(fw)[0]
+        assert np.abs(land.positions(theta) - X).max() < 1e-12

@@ -142,3 +142,29 @@ def _search_share(job: tuple) -> BoxSearch:
         left = None if deadline is None else max(deadline - time.time(), 1e-9)
         found = search(land, short, min_width, max_boxes=most, max_seconds=left, boxes=(lo, hi))
     return dataclasses.replace(found, cpu_seconds=time.process_time() - c0)
+
+
+# A finished search's undecided boxes, where few, searched again with sides this much finer:
+# next to a badly conditioned critical point (the pair about to meet at a fold, or the ghost
+# left where it has just vanished, grad V nearly 0) the enclosures decide only below the usual
+# smallest width. Along a continuum nothing decides at any width: the budget bounds that cost.
+DEEPER = 100
+DEEPEN_MOST = 2000  # undecided boxes at most, to search again
+DEEPEN_BOXES = 50  # ... with this many boxes for each
+
+
+def deepened(land: BoxLandscape, found: BoxSearch, short: float, min_width: float,
+             label: str = "real search") -> BoxSearch:  # fmt: skip
+    """`found` with its undecided boxes (if it stopped at the smallest width on at most
+    DEEPEN_MOST of them) searched again down to min_width / DEEPER, the records merged."""
+    left = found.undecided
+    if found.budget_hit or not 0 < len(left) <= DEEPEN_MOST:
+        return found
+    n = left.shape[1] // 2
+    again = search(land, short, min_width / DEEPER, max_boxes=DEEPEN_BOXES * len(left),
+                   label=f"{label}, {len(left)} undecided boxes again",
+                   boxes=(left[:, :n], left[:, n:]))  # fmt: skip
+    if again.budget_hit:  # a continuum, say: nothing gained, the first record stands
+        return found
+    head = dataclasses.replace(found, undecided=left[:0], edge=0)
+    return merged([head, again], found.volume, found.seconds + again.seconds)

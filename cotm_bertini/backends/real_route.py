@@ -304,6 +304,11 @@ class TorusFramework:
         """The points that are neither at a `known` one nor at an earlier one (fresh_points)."""
         return fresh_points(points, known)
 
+    def chart_points(self, cols: dict) -> np.ndarray:
+        """The chart points (R, n body angles) of a solutions table's rows (`cols`: columns)."""
+        angles = [np.asarray(cols[f"{b}.angle_deg"], dtype=float) for b in self.bodies]
+        return np.radians(np.stack(angles, axis=1)).reshape(-1, self.n)
+
     def endpoints(self, roots: np.ndarray) -> dict[tuple[str, ...], Endpoints]:
         """The critical points (R, n angles) as endpoints of their taut sets' systems."""
         d = self._lengths(roots)

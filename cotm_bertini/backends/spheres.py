@@ -36,7 +36,7 @@ import numpy as np
 from ..model.framework.ballcode import ball_module
 from ..model.framework.compiled import FrameworkSystem, framework_system, slot_vector
 from ..model.framework.reach import sphere_chain
-from ..model.framework.spec import Framework, owner
+from ..model.framework.spec import Framework, owner, units
 from ..model.framework.units import normalized_slots
 from ..model.intervals import Interval, stack
 from .boxes import EDGE, FREE, NONE, OFFSET
@@ -534,6 +534,26 @@ class SphereFramework:
     def positions(self, x: np.ndarray) -> np.ndarray:
         """Node coordinates (R, 3 per node) at points (R, n chart angles)."""
         return np.stack(self.kinematics(x)[0], axis=1)
+
+    def chart_points(self, cols: dict) -> np.ndarray:
+        """The chart points (R, n chart angles) of a solutions table's rows (`cols`: columns,
+        node positions in the file's units), each node in its most regular chart."""
+        scale = units(self.fw)[0]
+        rows = len(np.asarray(cols[f"{self.nodes[0]}.x"]))
+        x = np.empty((rows, self.n))
+        for i, v in enumerate(self.nodes):
+            top = self.parent[v]
+            if owner(top) == "ground":
+                g = top.split(".", 1)[1]
+                base = np.array([self.slots[f"g_{g}_{c}"] for c in "xyz"])[None, :]
+            else:
+                base = np.stack([np.asarray(cols[f"{top}.{c}"], float) for c in "xyz"], 1) / scale
+            u = np.stack([np.asarray(cols[f"{v}.{c}"], float) for c in "xyz"], 1) / scale - base
+            u /= np.linalg.norm(u, axis=1)[:, None]
+            b = np.arctan2(u[:, 1], u[:, 0])
+            x[:, 2 * i] = np.arccos(np.clip(u[:, 2], -1.0, 1.0))  # chart A, then the best one
+            x[:, 2 * i + 1] = np.where(b < OFFSET, b + 2 * math.pi, b)
+        return self.rechart(x)
 
     def rechart(self, x: np.ndarray) -> np.ndarray:
         """Points (R, n chart angles) with each node in the chart where it is most regular:

@@ -77,12 +77,17 @@ def framework_event_records(spec, table) -> list[dict]:
     # needs another generic set): said as it goes, after the sweep's last point.
     with Progress("sweep: events refined", len(pairs), "intervals", heartbeat=True) as report:
         for r, t in pairs:
-            (pa, pb), lo, past = (order[r][1], order[t][1]), order[r][1], None
+            (pa, pb), lo = (order[r][1], order[t][1]), order[r][1]
             note = _left_out(param, [order[k][1] for k in range(r + 1, t)])
+            # The sweep point's own solve, not solved again; the complex route's probes are
+            # continued from a solve of it (its `warm`: a start per taut set).
+            past = _Known(part[r]) if _real(spec) else _solver(spec)(lo)
+            ends = (past, _Known(part[t]))
             for _ in range(MAX_EVENTS):
                 if lo >= pb:
                     break
-                bracket = replace(_bisect(spec, lo, pb, past), start=(pa, pb))
+                bracket = _pinned(spec, lo, pb, past, ends[1]) or _bisect(spec, lo, pb, past)
+                bracket = replace(bracket, start=(pa, pb))
                 switches = _switches(spec, bracket)
                 events.extend(_describe(spec, bracket, (part[r], part[t]), switches, note))
                 # Two events between neighbouring points (their counts change twice): the
@@ -111,6 +116,20 @@ def _left_out(param: str, values: list[float]) -> str:
 
 
 @dataclass(frozen=True)
+class _Known:
+    """A sweep point's solve as a bracket end: its columns and status (nothing to warm from: a
+    probe continued from it solves in full)."""
+
+    columns: dict
+    warm: object = None
+
+    @property
+    def status(self) -> str:
+        status = set(np.asarray(self.columns["status"], dtype=object).tolist())
+        return "ok" if status <= {"ok"} else "incomplete"
+
+
+@dataclass(frozen=True)
 class _Bracket:
     lo: float
     hi: float
@@ -119,6 +138,68 @@ class _Bracket:
     refined: bool
     start: tuple[float, float]  # the sweep points on either side
     estimate: tuple[float, float] | None = None  # a fold left wider than tol: (value, error)
+    located: float | None = None  # a fold located by Newton on its system (fold_point.py)
+
+
+PIN_WIDEN = 16  # _pinned: a probe at the fold itself moves this many times farther out
+
+
+def _pinned(spec, lo: float, hi: float, below, above) -> _Bracket | None:
+    """The bracket of a fold between solves `below` (at lo) and `above` (at hi): the fold
+    located by Newton on its system from the pair that meets there (fold_point.py), then one
+    full solve on each side of it, tol / 2 away (moved out while a probe sees the pair as one
+    degenerate root). None where the pair is not found, Newton does not converge, or a probe
+    lands on the wrong side: bisection takes over."""
+    from .fold_point import locate_fold
+
+    start, end = _signature(below.columns), _signature(above.columns)
+    if abs(start[0] - end[0]) != 2 or below.status != "ok" or above.status != "ok":
+        return None
+    (p_more, more), (p_less, less) = ((lo, below), (hi, above))[:: 1 if start[0] > end[0] else -1]
+    pair = _new_rows(spec.model, more.columns, less.columns, 2)
+    land = _landscape(spec, p_more)
+    if land is None or len(pair) != 2:
+        return None
+    fold = locate_fold(spec.model, spec.param, land.chart_points(more.columns)[pair],
+                       p_more, p_less)  # fmt: skip
+    if fold is None or not lo < fold.value < hi:
+        return None
+    solve, tol = _solver(spec), BISECT_TOL * max(1.0, abs(lo), abs(hi))
+    sides = {-1: (tol / 2, None, start), 1: (tol / 2, None, end)}
+    while any(got is None for _, got, _ in sides.values()):
+        for side, (gap, got, want) in sides.items():
+            if got is not None:
+                continue
+            value = fold.value + side * gap
+            if not lo < value < hi or gap > (hi - lo) / 4:
+                return None
+            probe = solve(value, below.warm)
+            if _signature(probe.columns) == want and not _at_event(probe):
+                sides[side] = (gap, probe, want)
+            elif _signature(probe.columns) in (start, end) and not _at_event(probe):
+                return None  # on the wrong side: the fold is not where the counts change
+            else:
+                sides[side] = (gap * PIN_WIDEN, None, want)
+    (g_lo, b_lo, _), (g_hi, b_hi, _) = sides[-1], sides[1]
+    ok = b_lo.status == "ok" and b_hi.status == "ok"
+    return _Bracket(fold.value - g_lo, fold.value + g_hi, b_lo, b_hi, ok, (lo, hi),
+                    located=fold.value)  # fmt: skip
+
+
+def _real(spec) -> bool:
+    """The sweep's points are solved on the real route."""
+    from ..point import framework_route
+    from .runner import point_settings
+
+    return framework_route(spec.model, point_settings(spec)) == "real"
+
+
+def _landscape(spec, value: float):
+    """The real route's landscape of the swept framework at `value`, or None (not on it)."""
+    from ..backends.real_route import covers, landscape
+
+    fw = spec.model.replace(**{spec.param: value})
+    return landscape(fw) if not covers(fw) else None
 
 
 def _bisect(spec, pa: float, pb: float, below=None) -> _Bracket:
@@ -338,7 +419,8 @@ def _describe(spec, b: _Bracket, grids: tuple[dict, dict], switches: list, note:
             f"together, the softest Hessian eigenvalue {row['hess_min_eig']:.3g}: no fold)"
         )
         events.append({"kind": "cable_switch", **row, "description": what + note})
-    value, bracket = 0.5 * (b.lo + b.hi), b.hi - b.lo
+    value = 0.5 * (b.lo + b.hi) if b.located is None else b.located
+    bracket = b.hi - b.lo
     head = {param: value, "refined": b.refined, "bracket": bracket, **span}
     take = _new_rows(fw, more, less, change) if change else _closest_to_zero(lo_cols, 1)
     if change and not switches:

@@ -3,8 +3,10 @@ seconds, roots, cone points and boxes per equilibrium, one process each (`search
 derivations warm. With --dump FILE the roots go to a JSON file; with --against FILE (a dump made
 by another version of the package: `PYTHONPATH=<its checkout> python bench/searches.py --dump`)
 each example's roots are matched to those (angles to 1e-8 rad, mod 2 pi) and both versions'
-boxes printed side by side. Usage: python bench/searches.py [--only NAME ...] [--budget S]
-[--dump FILE] [--against FILE]."""
+boxes printed side by side. With --stable each example is searched twice in the same run, for
+every critical point and for the minima alone (`only="stable"`), and the minima compared.
+Usage: python bench/searches.py [--only NAME ...] [--budget S] [--dump FILE] [--against FILE]
+[--stable]."""
 
 from __future__ import annotations
 
@@ -37,8 +39,9 @@ FILES = {
 SETS = {"zeeman": {"x": 0.1, "y": -0.25}, "zeeman_cables": {"x": 1.45, "y": 0.2}}
 
 
-def run(name: str, budget: float) -> tuple[dict, np.ndarray]:
-    """One example's search: its row of the table, and its roots."""
+def run(name: str, budget: float, only: str = "all") -> tuple[dict, np.ndarray]:
+    """One example's search (for `only`: "all" critical points, or the "stable" ones): its row
+    of the table, and its roots."""
     import cotm_bertini as cb
     from cotm_bertini.backends.boxes import MIN_WIDTH, SHORT, search
     from cotm_bertini.backends.real_route import new_landscape
@@ -47,6 +50,7 @@ def run(name: str, budget: float) -> tuple[dict, np.ndarray]:
     if name in SETS:
         fw = fw.replace(**SETS[name])
     land = new_landscape(fw)
+    land.only = only
     search(land, SHORT, MIN_WIDTH, max_boxes=2000)  # derive and compile the code first
     t0 = time.perf_counter()
     found = search(land, SHORT, MIN_WIDTH, max_seconds=budget)
@@ -59,6 +63,32 @@ def run(name: str, budget: float) -> tuple[dict, np.ndarray]:
         "undecided_share": found.undecided_share, "boxes_per_point": found.boxes / max(points, 1),
         "proved": not found.budget_hit and not len(found.undecided),
     }, found.roots  # fmt: skip
+
+
+def minima(name: str, roots: np.ndarray) -> np.ndarray:
+    """The roots where the Hessian (double precision) is positive definite."""
+    import cotm_bertini as cb
+    from cotm_bertini.backends.real_route import new_landscape
+
+    fw = cb.Framework.from_toml(ROOT / FILES[name])
+    if not len(roots):
+        return roots
+    H = new_landscape(fw.replace(**SETS.get(name, {}))).derivatives(roots)[1]
+    return roots[np.linalg.eigvalsh(H)[:, 0] > 0]
+
+
+def stable_row(name: str, budget: float) -> dict:
+    """Both searches of one example, same run: boxes, seconds, minima, and whether the minima
+    agree (the stable search's roots may hold a few saddles the Hessian test could not drop:
+    the solve proves each root and drops those)."""
+    full, roots = run(name, budget)
+    only, kept = run(name, budget, "stable")
+    a, b = minima(name, roots), minima(name, kept)
+    return {"example": name, "angles": full["angles"], "boxes_all": full["boxes"],
+            "seconds_all": full["seconds"], "boxes_stable": only["boxes"],
+            "seconds_stable": only["seconds"], "minima": len(a), "roots_stable": len(kept),
+            "same_minima": same_roots(a, b) if full["proved"] and only["proved"] else None,
+            "box_ratio": only["boxes"] / max(full["boxes"], 1)}  # fmt: skip
 
 
 def same_roots(a: np.ndarray, b: np.ndarray, apart: float = 1e-8) -> bool:
@@ -78,7 +108,14 @@ def main() -> None:
     ap.add_argument("--budget", type=float, default=120.0, help="seconds, each example")
     ap.add_argument("--dump", type=Path, help="write the roots here (JSON)")
     ap.add_argument("--against", type=Path, help="a dump of another version to compare with")
+    ap.add_argument("--stable", action="store_true", help="every critical point, then minima")
     args = ap.parse_args()
+    if args.stable:
+        frame = pd.DataFrame([stable_row(n, args.budget) for n in args.only or FILES])
+        show("all critical points against the minima alone, one process", frame,
+             {"seconds_all": ".2f", "seconds_stable": ".2f", "box_ratio": ".3f"})  # fmt: skip
+        write_csv(frame, "searches_stable")
+        return
     other = json.loads(args.against.read_text()) if args.against else {}
     rows, dump = [], {}
     for name in args.only or FILES:

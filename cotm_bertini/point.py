@@ -6,11 +6,12 @@ run folder) -> endpoint table -> classified solutions, with path accounting and 
 
 from __future__ import annotations
 
+import dataclasses
 import tempfile
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from functools import cached_property
+from functools import cached_property, partial
 from pathlib import Path
 
 import numpy as np
@@ -330,7 +331,7 @@ def solve_framework_points(
     if not fws or framework_route(fws[0], settings) != "real":
         return [solve_framework_point(fw, settings, tolerances) for fw in fws]
     timings = [_framework_checks(fw, settings) for fw in fws]
-    ready = [_real_landscape(fw, t) for fw, t in zip(fws, timings, strict=True)]
+    ready = [_real_landscape(fw, t, settings.only) for fw, t in zip(fws, timings, strict=True)]
     found = search_frameworks(fws, settings.timeout, [land for land, _, _ in ready])
     out = []
     for fw, t, r, f in zip(fws, timings, ready, found, strict=True):
@@ -349,6 +350,19 @@ def check_route(model, settings: Settings, what: str = "solve") -> None:
         raise ParameterError(
             f"workers = {settings.workers!r} in the settings: a sweep or map solves each point "
             "in one process and splits its points over its own workers (workers=, --workers)"
+        )
+    if settings.only != "all" and what == "map":
+        raise ParameterError(
+            f"only = {settings.only!r}: a design map's fold curves and regions follow every "
+            "equilibrium; map with only='all'"
+        )
+    if settings.only != "all" and (
+        isinstance(model, Params) or framework_route(model, settings) != "real"
+    ):
+        name = "the paper's mechanism" if isinstance(model, Params) else model.name
+        raise ParameterError(
+            f"only = {settings.only!r}: a search of the real route's alone; {name} is solved "
+            "on the complex route, every critical point (its stable rows: result.stable)"
         )
     if not isinstance(model, Params):
         if framework_route(model, settings) == "complex" and workers:
@@ -412,16 +426,16 @@ SEEDS_AT_BUDGET = 512  # Newton starts in the boxes a search stopped by its budg
 DESCENTS = 64  # local descents from random poses when a search is stopped by its budget
 
 
-def _real_landscape(fw, t: Timings) -> tuple:
-    """(the real route's landscape of `fw`, its taut sets, those pruned), every taut set's
-    equations derived and checked."""
+def _real_landscape(fw, t: Timings, only: str = "all") -> tuple:
+    """(the real route's landscape of `fw` searching for `only`, its taut sets, those pruned),
+    every taut set's equations derived and checked."""
     from .backends.real_route import landscape
     from .model.framework.compiled import check_terms
     from .model.framework.units import normalized_slots
 
     sets, pruned = split_taut_sets(fw)
     with t.stage("derive"):
-        land = landscape(fw)
+        land = landscape(fw, only)
         target = normalized_slots(fw)
         for taut, fs in land.hessian_sets:  # derived (or loaded) here, not in the search's clock
             if taut in sets:
@@ -446,14 +460,18 @@ def _solve_real(
     from .model.framework.units import units
 
     unit = units(fw)
-    land, sets, pruned = ready or _real_landscape(fw, t)
+    land, sets, pruned = ready or _real_landscape(fw, t, settings.only)
     with t.stage("solve"):
         if found is None:  # shared over local processes or a Dask cluster where asked
-            found = split_search(landscape, fw, SHORT, MIN_WIDTH, workers=settings.workers,
-                                 scheduler=settings.scheduler, max_seconds=settings.timeout,
+            found = split_search(partial(landscape, only=settings.only), fw, SHORT, MIN_WIDTH,
+                                 workers=settings.workers, scheduler=settings.scheduler,
+                                 max_seconds=settings.timeout,
                                  label=f"real search of {fw.name}")  # fmt: skip
         found = deepened(land, found, SHORT, MIN_WIDTH, f"real search of {fw.name}")
         seeds, descents, regions = _unproved(land, found, unit, settings.seed)
+        stability = None
+        if settings.only == "stable":
+            found, seeds, stability = _minima_only(land, found, seeds, settings.seed)
         groups = land.endpoints(np.vstack([found.roots, seeds]))
     report: dict = {" ".join(taut) or "none": {"excluded": True, "pruned": "bound smoothing",
                     "note": why.note()} for taut, why in pruned.items()}  # fmt: skip
@@ -464,7 +482,7 @@ def _solve_real(
         table = order_rows(fw, [p[0] for p in parts])
         cones = cone_records(land, found, unit)
         checks = completeness(fw, table, report, continua, near_cones=found.set_aside_boxes,
-                              cones=cones)  # fmt: skip
+                              cones=cones, morse=stability is None)  # fmt: skip
     morse_bott = all(c.index is not None for c in continua)
     search_info = real_search_info(found, unit[0], along_continua(land, found, continua),
                                    morse_bott, regions)  # fmt: skip
@@ -472,9 +490,32 @@ def _solve_real(
     search_info["cone_points"] = cones
     if descents["starts"]:
         search_info["descents"] = {k: v for k, v in descents.items() if k != "points"}
-    warnings = tuple(search_info["warnings"] + checks["warnings"])
-    status = STATUS_INCOMPLETE if warnings else STATUS_OK
     failure = checks["morse"].get("failure")
+    if stability is not None:
+        search_info["only"] = stability
+        search_info["warnings"] += stability.pop("warnings")
+        failure = stability.pop("failure")
+    status, warnings = _real_status(found, search_info, checks, failure)
+    counts = {**framework_counts(table, report, continua), "boxes": found.boxes}
+    engine = {"flavour": "real", "path": "branch and bound (backends.boxes)", "version": ""}
+    shape = {"taut_sets": list(report), "units": {"length": unit[0], "stiffness": unit[1]}}
+    return PointSolution(
+        fw, settings, table, None, counts, checks["morse"],
+        status, warnings, engine, shape, {"taut_sets": report, "real_search": search_info}, "",
+        t.stages, None,
+        tuple(continuum_record(c, n) for n, c in enumerate(continua, start=1)),
+    )  # fmt: skip
+
+
+def _real_status(found, search_info: dict, checks: dict, failure: str | None) -> tuple:
+    """(status, warnings) of a real search: ok, incomplete where it or the checks left
+    something, contradiction where the search proved its rows complete yet a check that shares
+    none of its code (`failure`: the Morse count's, or the descents' of a search for minima)
+    says they are not."""
+    warnings = tuple(search_info["warnings"] + checks["warnings"])
+    if failure and not any(w.startswith(failure) for w in warnings):
+        warnings = (*warnings, f"{failure}: equilibria may be missing")
+    status = STATUS_INCOMPLETE if warnings else STATUS_OK
     if failure and search_info["free_regions"]:
         # A region of equilibria has no term in the Morse sum: the count says nothing here.
         checks["morse"].update(
@@ -482,7 +523,7 @@ def _solve_real(
         )
         warnings = tuple(w for w in warnings if not w.startswith(failure))
         status, failure = (STATUS_INCOMPLETE if warnings else STATUS_OK), None
-    if failure and not search_info["warnings"] and not checks["morse"]["degenerate"]:
+    if failure and not search_info["warnings"] and not checks["morse"].get("degenerate"):
         # The search proved its rows are every critical point; the Morse count, which shares
         # none of its code, says they are not: one of the two is wrong, and no later check
         # can tell which. That is a bug to report, never a set that "may" be incomplete.
@@ -493,15 +534,47 @@ def _solve_real(
                     f"points are all there are, yet {failure}: a bug (please report it with "
                     "run.json)",
                     *(w for w in warnings if not w.startswith(failure)))  # fmt: skip
-    counts = {**framework_counts(table, report, continua), "boxes": found.boxes}
-    engine = {"flavour": "real", "path": "branch and bound (backends.boxes)", "version": ""}
-    shape = {"taut_sets": list(report), "units": {"length": unit[0], "stiffness": unit[1]}}
-    return PointSolution(
-        fw, settings, table, None, counts, checks["morse"],
-        status, warnings, engine, shape, {"taut_sets": report, "real_search": search_info}, "",
-        t.stages, None,
-        tuple(continuum_record(c, n) for n, c in enumerate(continua, start=1)),
-    )  # fmt: skip
+    return status, warnings
+
+
+def _minima_only(land, found, seeds: np.ndarray, seed: int | None) -> tuple:
+    """(found, seeds, what was proved) of a search for the stable equilibria alone: its roots
+    proved minima or not (backends.minima; those proved not to be dropped, the undecided kept
+    with a warning), the seeds Newton found (not proved) kept where their Hessian is positive
+    definite."""
+    from .backends.minima import proved_minima
+    from .backends.real_route import descent_minima
+
+    verdict = proved_minima(land, found.roots)
+    keep = verdict >= 0
+    found = dataclasses.replace(found, roots=found.roots[keep],
+                                root_boxes=found.root_boxes[keep])  # fmt: skip
+    if len(seeds):
+        seeds = seeds[np.linalg.eigvalsh(land.derivatives(seeds)[1])[:, 0] > 0]
+    # The check that shares no code with the search (the Morse count has no use here): local
+    # descents from random poses; a minimum they reach that the search did not find joins the
+    # rows, and where the search was proved complete that is a contradiction.
+    reached = land.fresh(descent_minima(land, DESCENTS, 0 if seed is None else seed),
+                         np.zeros((0, land.n)))  # fmt: skip
+    missed = land.fresh(reached, np.vstack([found.roots, seeds]))
+    seeds = np.vstack([seeds, missed])
+    unsure = int((verdict == 0).sum())
+    said = [f"{unsure} critical points found where only minima were looked for are neither "
+            "proved minima nor proved not to be (degenerate, or too badly conditioned): kept, "
+            "with the kind their Hessian gives"] * bool(unsure)  # fmt: skip
+    failure = (
+        (
+            f"{len(missed)} of the {len(reached)} minima that local descents from "
+            f"{DESCENTS} random poses reach are not among the search's"
+        )
+        if len(missed)
+        else None
+    )
+    return found, seeds, {"what": "stable", "proved_minima": int((verdict == 1).sum()),
+                          "undecided": unsure, "dropped": int((verdict == -1).sum()),
+                          "descents": {"starts": DESCENTS, "minima": len(reached),
+                                       "not_found_by_the_search": len(missed)},
+                          "warnings": said, "failure": failure}  # fmt: skip
 
 
 def _unproved(land, found, unit: tuple[float, float], seed: int | None) -> tuple:

@@ -29,6 +29,7 @@ CONFIG_KEYS = {
 
 ENGINES = ("homotopy", "cli")
 ROUTES = (None, "real", "complex")
+ONLY = ("all", "stable")
 GENERIC_ROUTES = (None, "monodromy", "total-degree", "both")
 DEFAULT_CLI_TIMEOUT = 600.0
 
@@ -76,6 +77,10 @@ class Settings:
     # in this process for two seconds, then what it has not decided over one process a core);
     # not part of a result's key. A sweep or map splits its points instead.
     workers: int | None = None
+    # What a solve looks for: "all" critical points, or the "stable" equilibria alone (the
+    # real route's search drops every box where V can have no local minimum; docs/frameworks.md,
+    # "Only the stable equilibria").
+    only: str = "all"
 
     def __new__(cls, *args: object, **values: object) -> Settings:
         """Refuse an unknown setting with ParameterError (not a bare TypeError)."""
@@ -119,6 +124,8 @@ class Settings:
             raise ParameterError(
                 f"generic = {self.generic!r}: expected 'monodromy', 'total-degree' or 'both'"
             )
+        if self.only not in ONLY:
+            raise ParameterError(f"only = {self.only!r}: expected 'all' or 'stable'")
         if self.route not in ROUTES:
             raise ParameterError(f"route = {self.route!r}: expected 'real' or 'complex'")
         if self.route == "real" and self.generic is not None:

@@ -182,13 +182,13 @@ def _continued(th: np.ndarray, start: float, stop: float, steps: int = 50) -> np
     return np.mod(th, 2 * np.pi)
 
 
-def _sweep(root: Path, start: float, stop: float, points: int):
+def _sweep(root: Path, start: float, stop: float, points: int, *more: str):
     """`sweep --framework` of the chain: (exit code, events.csv, sweep.csv)."""
     path = root / "chain3.toml"
     path.write_text(CHAIN)
     code = main(["sweep", "--framework", str(path), "--param", "L01", "--from", str(start),
                  "--to", str(stop), "--points", str(points), "--workers", "1", "--quiet",
-                 "--no-plots", "--out", str(root / "out")])  # fmt: skip
+                 "--no-plots", "--out", str(root / "out"), *more])  # fmt: skip
     folder = next((root / "out").glob("sweep-*"))
     return code, pd.read_csv(folder / "events.csv"), pd.read_csv(folder / "sweep.csv")
 
@@ -290,3 +290,18 @@ def test_a_fold_is_located_on_its_system_and_proved_by_two_solves(tmp_path, monk
     assert len(fold) == 1 and len(calls) == 2, events.to_string()
     assert bool(fold["refined"].iloc[0]) and fold["bracket"].iloc[0] < 2e-9
     assert abs(fold["L01"].iloc[0] - _fold(LO, HI, _minima)) < 1e-6
+
+
+def test_a_sweep_of_the_stable_states_alone_finds_the_fold_where_a_minimum_is_born(tmp_path):
+    """`--only stable`: the points hold their minima alone (1 at LO, 2 at HI); the fold where a
+    minimum is born (with a saddle, not looked for) is located from that one minimum, proved on
+    both sides, at the independent value, and named a fold."""
+    code, events, table = _sweep(tmp_path, LO, HI, 2, "--only", "stable")
+    assert code == 0
+    assert sorted(table.groupby("L01")["stable"].sum()) == [1, 2]
+    assert set(table["kind"]) == {"min"}
+    fold = events[events["kind"] == "fold"]
+    assert len(fold) == 1, events.to_string()
+    assert bool(fold["refined"].iloc[0]) and fold["bracket"].iloc[0] < 2e-9
+    assert abs(fold["L01"].iloc[0] - _fold(LO, HI, _minima)) < 1e-6
+    assert fold["description"].iloc[0].startswith("a min is born at a fold")

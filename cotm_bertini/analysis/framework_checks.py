@@ -90,11 +90,18 @@ def framework_counts(table: dict, report: dict, continua: list = ()) -> dict:
 
 
 def completeness(
-    fw: Framework, table: dict, report: dict, continua: list = (), near_cones=None, cones=None
+    fw: Framework,
+    table: dict,
+    report: dict,
+    continua: list = (),
+    near_cones=None,
+    cones=None,
+    morse: bool = True,
 ) -> dict:
     """Why no equilibrium is missing, or warnings saying why one may be: {"morse", "warnings"}
     (`continua`: analysis.framework_continua's, each a term of the Morse sum; `cones`: the
-    real search's proved cone points, each a term)."""
+    real search's proved cone points, each a term; `morse` False: the rows are the minima
+    alone, and the Morse sum does not apply)."""
     warnings = []
     for label, info in report.items():
         if info.get("route") == "real":  # the search's own record says what it left
@@ -122,6 +129,10 @@ def completeness(
                 f"taut set {label}: {info['generic_singular']} singular endpoints at generic "
                 "parameters (a positive-dimensional solution set, not enumerated)"
             )
+    if not morse:
+        reason = "only the stable equilibria were searched for (no saddle or maximum)"
+        return {"morse": {"applicable": False, "ok": None, "reason": reason},
+                "warnings": warnings}  # fmt: skip
     morse = morse_count(fw, table, continua, near_cones, cones)
     if morse.get("continuum_unknown"):
         warnings.append(f"{morse['reason']}: the Morse check is not applicable, so equilibria "

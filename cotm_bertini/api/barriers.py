@@ -93,6 +93,11 @@ def barriers(res: Solutions, max_steps: int = MAX_STEPS) -> Barriers:
     the minima, and the barriers; each descent takes at most `max_steps` steps."""
     if isinstance(max_steps, bool) or not isinstance(max_steps, int | np.integer) or max_steps < 1:
         raise ParameterError(f"max_steps = {max_steps!r}: expected a whole number >= 1")
+    if res.settings.only != "all":
+        raise ParameterError(
+            f"only = {res.settings.only!r}: barriers are read off the saddles between the "
+            "minima, which that solve did not look for; solve with only='all'"
+        )
     t0 = time.perf_counter()
     table, paths = saddle_connections(flow_of(res.params, res.table), res.table, int(max_steps))
     table = table.set_axis(pd.Index(table["saddle_id"].to_numpy(dtype=int)), axis=0)

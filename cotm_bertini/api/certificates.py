@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ..errors import CertificateError
+from ..errors import CertificateError, ParameterError
 from ..params import Params
 from .solutions import Solutions
 
@@ -22,6 +22,11 @@ def certify(res: Solutions, strict: bool = True):
     in run.json). With `strict` (default), a difference between the proof and the table raises
     CertificateError (the certificate is still attached: save the run to keep the evidence).
     """
+    if res.settings.only != "all":
+        raise ParameterError(
+            f"only = {res.settings.only!r}: the certificate proves that no equilibrium of any "
+            "kind is missing; certify a solve with only='all'"
+        )
     table = res.table.reset_index(drop=True)  # rows by position
     if isinstance(res.params, Params):
         from ..analysis.certify.mechanism import certify_table

@@ -46,6 +46,7 @@ from ..progress import Progress
 from .cones import cone_test, near_cone
 from .cones import sub_landscape as _sub
 from .krawczyk import krawczyk_step
+from .stability import no_minimum
 
 TWO_PI = 2 * math.pi
 OFFSET = -0.0123456789  # radians: the domain's lower corner (see the module docstring)
@@ -91,6 +92,8 @@ class BoxLandscape(Protocol):
     # be so but is not proved; NONE where no critical point is in the box: see _step.
     # Optional: `contract(box) -> (lo, hi)`, called right after `enclose(box)`: each box shrunk
     # to a box that holds every critical point it holds (lo > hi: none).
+    # Optional: `only` ("all"; "stable": a box where V can have no local minimum is dropped,
+    # backends.stability, so that the roots found include every minimum, not every saddle).
 
 
 class BoxFamily(Protocol):
@@ -633,9 +636,26 @@ def _inflated(lo, hi, outer_lo, outer_hi) -> tuple:
 
 def _tested(land, lo, hi, cand, states, free, slack) -> tuple:
     """The Krawczyk test of the batch's boxes `cand`: (verdict, the roots found as _roots
-    gives them, the free pieces (rows, lo hi point mask))."""
-    verdict, k_lo, k_hi = krawczyk(_sub(land, cand), lo[cand], hi[cand], _subset(states, cand),
-                                   free[cand], _subset(slack, cand))  # fmt: skip
+    gives them, the free pieces (rows, lo hi point mask)). Looking for minima alone (`only`),
+    a box where V can have none (backends.stability, on the test's own slope matrix) is
+    excluded first."""
+    h = _sub(land, cand).hessian(Interval(lo[cand], hi[cand]), _subset(states, cand))
+    keep = np.ones(len(cand), dtype=bool)
+    if getattr(land, "only", "all") == "stable":
+        keep = ~no_minimum(h) | free[cand].any(axis=1)
+    verdict = np.full(len(cand), -1, dtype=np.int8)
+    k_lo, k_hi = lo[cand], hi[cand]
+    if keep.any():
+        at = cand[keep]
+        verdict[keep], k_lo[keep], k_hi[keep] = krawczyk(
+            _sub(land, at),
+            lo[at],
+            hi[at],
+            _subset(states, at),
+            free[at],
+            _subset(slack, at),
+            Interval(h.lo[keep], h.hi[keep]),
+        )
     n = lo.shape[1]
     found = (cand[:0], np.zeros((0, n)), np.zeros((0, 2 * n)), np.zeros(0, dtype=bool))
     pieces = (cand[:0], np.zeros((0, 4 * n)))
@@ -728,17 +748,18 @@ def _split(lo: np.ndarray, hi: np.ndarray, parent: np.ndarray, free=None) -> tup
     return lo, hi, parent
 
 
-def krawczyk(land: BoxLandscape, lo, hi, states, free=None, slack=None) -> tuple:
+def krawczyk(land: BoxLandscape, lo, hi, states, free=None, slack=None, h=None) -> tuple:
     """(verdict, K lo, K hi) per box: 1 exactly one critical point (in K), -1 none, 0 unknown.
     Along `free` angles ((B, n) bool) grad V is 0 whatever they are: the test is that of the
     other components in the other angles (their gradient does not depend on the free ones over
     the box), and a 1 says each value of the free angles has exactly one critical point of the
     others, the same one (the free angles of K are the box's middle). `slack`: the cables
-    the landscape takes as slack over each box (its `free`), at the middle too."""
+    the landscape takes as slack over each box (its `free`), at the middle too. `h`: the slope
+    matrix over the boxes, where already made."""
     n = lo.shape[1]
     mid = 0.5 * (lo + hi)
     _, g_mid, _ = land.enclose(Interval(mid), slack=slack) if slack else land.enclose(Interval(mid))
-    h = land.hessian(Interval(lo, hi), states)
+    h = land.hessian(Interval(lo, hi), states) if h is None else h
     if free is None or not free.any():
         return krawczyk_step(lo, hi, g_mid, h)
     both = ~free[:, :, None] & ~free[:, None, :]

@@ -55,6 +55,8 @@ from .links import (
 )
 from .spheres import SphereFramework
 
+ONLY = ("all", "stable")  # what a search looks for: every critical point, or the minima
+
 
 def covers(fw: Framework) -> str:
     """'' where the real route covers the framework's configuration space (a circle or torus
@@ -67,11 +69,17 @@ def covers(fw: Framework) -> str:
 
 
 @lru_cache(maxsize=8)
-def landscape(fw: Framework) -> TorusFramework | SphereFramework:
+def landscape(fw: Framework, only: str = "all") -> TorusFramework | SphereFramework:
     """V over boxes of the framework's configuration space (covers says which), built once a
     process: a worker searching several shares of its boxes (backends.box_shares) rebuilds it
-    once, and the solve that dealt them not again."""
-    return new_landscape(fw)
+    once, and the solve that dealt them not again. `only`: "all" critical points are searched
+    for, or the "stable" ones alone (boxes where V can have no local minimum are dropped:
+    backends.stability)."""
+    if only not in ONLY:
+        raise ValueError(f"only = {only!r}: expected one of {ONLY}")
+    land = new_landscape(fw)
+    land.only = only
+    return land
 
 
 def new_landscape(fw: Framework) -> TorusFramework | SphereFramework:
@@ -97,6 +105,8 @@ def moved_landscape(land, fw: Framework, slots: dict):
 
 class TorusFramework:
     """V of a planar framework pinned in an open chain, over boxes of its body angles."""
+
+    only = "all"  # which critical points a search of it looks for (`landscape`)
 
     def __init__(self, fw: Framework):
         why = covers(fw)

@@ -109,6 +109,8 @@ def directions(a, b, second: bool = True) -> dict[str, list]:
 class SphereFramework:
     """V of a spatial framework whose nodes hang from the ground by bars, over chart boxes."""
 
+    only = "all"  # which critical points a search of it looks for (real_route.landscape)
+
     def __init__(self, fw: Framework):
         chain, why = sphere_chain(fw)
         if why:

@@ -15,6 +15,7 @@ from .options import (
     EXIT_USAGE,
     Parser,
     add_case,
+    add_only,
     add_params,
     add_route,
     add_settings,
@@ -41,6 +42,7 @@ def _solve_parser(sub) -> None:
     add_case(s)
     add_params(s)
     add_settings(s)
+    add_only(s)
     s.add_argument("--out", metavar="DIR", help="root of run folders (default runs/<label>)")
     s.add_argument(
         "--no-plots", action="store_true", help="skip the figures (and the import of matplotlib)"
@@ -101,6 +103,7 @@ def _sweep_parser(sub) -> None:
     w.add_argument("--points2", type=int, help="number of values of --param2")
     add_params(w)
     add_settings(w)
+    add_only(w)
     w.add_argument("--workers", type=int, help="local processes (default: one per core)")
     w.add_argument("--scheduler", metavar="ADDRESS", help="a Dask scheduler, tcp://host:8786")
     w.add_argument("--out", metavar="DIR", default="runs", help="root of sweep folders (runs)")

@@ -271,4 +271,17 @@ def settings_from(args: argparse.Namespace) -> Settings:
         )
         if getattr(args, name, None) is not None
     }
+    if getattr(args, "only", None) is not None:
+        given["only"] = args.only
     return Settings(**given)
+
+
+def add_only(p: argparse.ArgumentParser) -> None:
+    """--only: every equilibrium, or the stable ones alone (a solve or a sweep)."""
+    p.add_argument(
+        "--only",
+        choices=("all", "stable"),
+        help="what is looked for: all equilibria (default), or the stable ones alone, each "
+        "proved a strict local minimum and none missing (the real route: boxes where V can "
+        "have no local minimum are dropped; no saddle, maximum or Morse count)",
+    )

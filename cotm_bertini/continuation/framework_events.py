@@ -153,12 +153,13 @@ def _pinned(spec, lo: float, hi: float, below, above) -> _Bracket | None:
     from .fold_point import locate_fold
 
     start, end = _signature(below.columns), _signature(above.columns)
-    if abs(start[0] - end[0]) != 2 or below.status != "ok" or above.status != "ok":
+    meet = 1 if _minima_only(spec) else 2  # (a minimum's partner at its fold: not searched)
+    if abs(start[0] - end[0]) != meet or below.status != "ok" or above.status != "ok":
         return None
     (p_more, more), (p_less, less) = ((lo, below), (hi, above))[:: 1 if start[0] > end[0] else -1]
-    pair = _new_rows(spec.model, more.columns, less.columns, 2)
+    pair = _new_rows(spec.model, more.columns, less.columns, meet)
     land = _landscape(spec, p_more)
-    if land is None or len(pair) != 2:
+    if land is None or len(pair) != meet:
         return None
     fold = locate_fold(spec.model, spec.param, land.chart_points(more.columns)[pair],
                        p_more, p_less)  # fmt: skip
@@ -184,6 +185,11 @@ def _pinned(spec, lo: float, hi: float, below, above) -> _Bracket | None:
     ok = b_lo.status == "ok" and b_hi.status == "ok"
     return _Bracket(fold.value - g_lo, fold.value + g_hi, b_lo, b_hi, ok, (lo, hi),
                     located=fold.value)  # fmt: skip
+
+
+def _minima_only(spec) -> bool:
+    """The sweep's points hold their stable equilibria alone (Settings.only)."""
+    return spec.settings.get("only", "all") == "stable"
 
 
 def _real(spec) -> bool:
@@ -433,6 +439,13 @@ def _describe(spec, b: _Bracket, grids: tuple[dict, dict], switches: list, note:
             kinds = np.asarray(grid["kind"], dtype=object)[_nearest(fw, grid, more, involved)]
             across = np.asarray(other["kind"], dtype=object)[_nearest(fw, other, more, [third])]
             kind, words, tail = "pitchfork", _pitchfork_words(kinds, across[0], born), ""
+        elif b.located is not None and change == 1 and _minima_only(spec):
+            verb = "is born" if born else "vanishes"
+            kind, words, tail = (
+                "fold",
+                f"a min {verb} at a fold (with a saddle, not looked for)",
+                "",
+            )
         else:
             kind, words, tail = _kind_words(_kinds(more) - _kinds(less), change, born)
             cone = _cone(spec, b) if change == 1 else None

@@ -64,6 +64,13 @@ def summary_head(record: dict, cached: bool = False) -> str:
     apart = f"; {continua} continua of equilibria apart" if continua else ""
     regions = len(record.get("details", {}).get("real_search", {}).get("free_regions", []))
     apart += f"; {regions} {_plural(regions, 'region')} of equilibria apart" if regions else ""
+    only = record.get("details", {}).get("real_search", {}).get("only")
+    if engine["flavour"] == "real" and only:
+        return (
+            f"{c['stable']} stable equilibria{apart} ({only['proved_minima']} proved strict "
+            f"local minima; only the stable ones were looked for) by the real route: a branch "
+            f"and bound of {c['boxes']:,} boxes over its configuration space; {seconds}"
+        )
     if engine["flavour"] == "real":
         return (
             f"{c['physical']} equilibria ({c['stable']} stable{apart}; {c['distinct_solutions']}"

@@ -351,11 +351,6 @@ def check_route(model, settings: Settings, what: str = "solve") -> None:
             f"workers = {settings.workers!r} in the settings: a sweep or map solves each point "
             "in one process and splits its points over its own workers (workers=, --workers)"
         )
-    if settings.only != "all" and what == "map":
-        raise ParameterError(
-            f"only = {settings.only!r}: a design map's fold curves and regions follow every "
-            "equilibrium; map with only='all'"
-        )
     if settings.only != "all" and (
         isinstance(model, Params) or framework_route(model, settings) != "real"
     ):

@@ -102,7 +102,8 @@ def test_a_test_that_drops_a_box_with_a_minimum_is_caught(monkeypatch):
 
 def test_what_only_stable_cannot_answer_is_refused():
     """A setting is honoured or refused: the paper's mechanism (Bertini's complex roots), the
-    complex route, a design map, a certificate and barriers need every equilibrium."""
+    complex route, a map's continuation grid, a certificate and barriers need every
+    equilibrium."""
     fw = cb.Framework.from_toml(ROOT / "examples" / "chain3.toml")
     with pytest.raises(ParameterError, match="only = 'stable'"):
         cb.solve(cb.Params.case("case3"), only="stable")
@@ -110,16 +111,9 @@ def test_what_only_stable_cannot_answer_is_refused():
         cb.solve(fw, route="complex", only="stable")
     with pytest.raises(ParameterError, match="only = 'anything'"):
         cb.Settings(only="anything")
-    with pytest.raises(ParameterError, match="design map"):
-        cb.design_map(
-            fw,
-            "L0",
-            (1.0, 2.0),
-            "weight",
-            (0.0, 0.2),
-            points=3,
-            settings=cb.Settings(only="stable"),
-        )
+    with pytest.raises(ParameterError, match="grid = 'continuation' with only = 'stable'"):
+        cb.design_map(fw, "L0", (1.0, 2.0), "weight", (0.0, 0.2), points=3,
+                      settings=cb.Settings(only="stable"), grid="continuation")  # fmt: skip
     res = cb.solve(fw, cache=False, only="stable")
     for call in (cb.certify, cb.barriers):
         with pytest.raises(ParameterError, match="only = 'stable'"):
@@ -133,3 +127,17 @@ def test_the_command_line_solves_the_stable_equilibria_alone(tmp_path, capsys):
     out = capsys.readouterr().out
     assert code == 0
     assert "5 stable equilibria (5 proved strict local minima; only the stable ones" in out
+
+
+def test_a_map_of_the_stable_states_is_proved_at_every_grid_point():
+    """Zeeman's machine over (x, y), only="stable": every grid point searched for its minima
+    (a 2-D sweep, each point proved), the stable counts those of the full map's grid, and the
+    map's check (every change of the count crossed by a fold curve) passes."""
+    fw = cb.Framework.from_toml(ROOT / "examples" / "zeeman.toml")
+    window = ("x", (-0.6, 0.8), "y", (-0.8, 0.2))
+    full = cb.design_map(fw, *window, points=15, grid="search")
+    only = cb.design_map(fw, *window, points=15, settings=cb.Settings(only="stable"))
+    assert only.record["sweep_status"] == "ok" and only.record["status"] == "ok"
+    assert (only.regions["stable"].to_numpy() == full.regions["stable"].to_numpy()).all()
+    assert (only.regions["physical"] == only.regions["stable"]).all()
+    assert len(set(only.regions["stable"])) == 2  # the cusp region's two minima, one outside

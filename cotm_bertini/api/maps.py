@@ -174,8 +174,8 @@ GRIDS = ("auto", "search", "continuation")
 def grid_route(model, grid: str, settings: Settings) -> str:
     """How the map's grid is made: "search" (every grid point solved), "continuation" (a
     framework on the real route: anchors searched, equilibria followed in chart angles), "auto"
-    (continuation for a product of spheres, whose fold systems sympy cannot expand); or a
-    one-line refusal."""
+    (continuation for a product of spheres, whose fold systems sympy cannot expand; a search
+    of every point where only the stable equilibria are asked for); or a one-line refusal."""
     from ..backends.real_route import covers
     from ..errors import ParameterError
     from ..point import framework_route
@@ -186,6 +186,14 @@ def grid_route(model, grid: str, settings: Settings) -> str:
     if grid == "continuation" and not real:
         raise ParameterError("grid = 'continuation': only for a framework on the real route "
                              "(a torus of body angles or a product of spheres)")  # fmt: skip
+    if grid == "continuation" and settings.only != "all":
+        raise ParameterError(
+            f"grid = 'continuation' with only = {settings.only!r}: continuation follows every "
+            "equilibrium from the anchors; the stable ones alone are proved at every grid point "
+            "by grid = 'search'"
+        )
+    if grid == "auto" and settings.only != "all":
+        return "search"
     if grid == "auto":
         return "continuation" if real and covers(model) == "" and model.dim == 3 else "search"
     return grid

@@ -519,6 +519,8 @@ def descent_minima(land, starts: int, seed: int, steps: int = 200) -> np.ndarray
         step = np.where((eig > 0).all(axis=1)[:, None], newton, g)
         step *= np.minimum(1.0, 0.2 / np.maximum(np.abs(step).max(axis=1), 1e-300))[:, None]
         x = rechart(x - step)
+        if np.abs(step).max(initial=0.0) < 1e-15:  # every descent has arrived (or is stuck)
+            break
     g, h = land.derivatives(x)
     good = (np.abs(g).max(axis=1) < 1e-10) & (np.linalg.eigvalsh(h) > 0).all(axis=1)
     return x[good]

@@ -192,6 +192,12 @@ def grid_route(model, grid: str, settings: Settings) -> str:
             "equilibrium from the anchors; the stable ones alone are proved at every grid point "
             "by grid = 'search'"
         )
+    if settings.only != "all" and real and model.dim == 3:
+        raise ParameterError(
+            f"only = {settings.only!r}: a spatial map's fold curves are traced in chart angles "
+            "from its continuation grid, which follows every equilibrium; map it with "
+            "only='all', or sweep one parameter with only='stable' (every point proved)"
+        )
     if grid == "auto" and settings.only != "all":
         return "search"
     if grid == "auto":

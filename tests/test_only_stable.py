@@ -145,3 +145,25 @@ def test_a_map_of_the_stable_states_is_proved_at_every_grid_point():
     assert (only.regions["stable"].to_numpy() == full.regions["stable"].to_numpy()).all()
     assert (only.regions["physical"] == only.regions["stable"]).all()
     assert len(set(only.regions["stable"])) == 2  # the cusp region's two minima, one outside
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", range(20))
+@pytest.mark.parametrize("kind", ["chain2", "chain3", "collapse3", "hanging2"])
+def test_random_mechanisms_give_the_full_search_s_stable_rows(kind, seed, tmp_path):
+    """(make stress) Random chains (some with springs that can collapse) and hanging nodes:
+    `only="stable"` gives the full search's stable rows, with the same status."""
+    if kind == "hanging2":
+        m = rm.hanging_nodes(seed, 2)
+    else:
+        m = rm.planar_chain(seed, 2 if kind == "chain2" else 3, collapse=kind == "collapse3")
+    path = tmp_path / "f.toml"
+    path.write_text(m.toml(f"{kind}_{seed}"))
+    fw = cb.Framework.from_toml(path)
+    full = cb.solve(fw, cache=False, timeout=120)
+    only = cb.solve(fw, cache=False, only="stable", timeout=120)
+    assert full.status == only.status == "ok", (full.warnings, only.warnings)
+    a, b = _pose(full.stable), _pose(only.physical)
+    assert len(a) == len(b)
+    for x in a:
+        assert np.abs(b - x).max(axis=1).min() < 1e-7

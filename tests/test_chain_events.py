@@ -305,3 +305,33 @@ def test_a_sweep_of_the_stable_states_alone_finds_the_fold_where_a_minimum_is_bo
     assert bool(fold["refined"].iloc[0]) and fold["bracket"].iloc[0] < 2e-9
     assert abs(fold["L01"].iloc[0] - _fold(LO, HI, _minima)) < 1e-6
     assert fold["description"].iloc[0].startswith("a min is born at a fold")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", [1, 3, 4])
+def test_random_chains_folds_located_on_their_systems_are_the_bisection_s(seed, tmp_path,
+                                                                       monkeypatch):  # fmt: skip
+    """(make stress) A random three-link chain, one spring's free length swept over 41 points:
+    the events with folds located on their systems are the bisection's (kind, value to 1e-6),
+    a route that shares neither the fold system nor its two probes."""
+    import re
+
+    import random_mechanisms as rm
+
+    import cotm_bertini as cb
+    import cotm_bertini.continuation.framework_events as fe
+
+    text = rm.planar_chain(seed, 3).toml(f"chain_{seed}")
+    m = re.search(r"\[\[springs\]\][^\[]*?L0 = ([0-9.eE+-]+)", text, re.S)
+    v = float(m.group(1))
+    text = text[: m.start(1)] + '"P"' + text[m.end(1) :]
+    path = tmp_path / "chain.toml"
+    path.write_text(text.replace("dim = 2\n", f"dim = 2\n\n[parameters]\nP = {v}\n", 1))
+    fw = cb.Framework.from_toml(path)
+    values = np.linspace(0.3 * v, 2.0 * v, 41)
+    located = cb.sweep(fw, "P", values, out=tmp_path / "a").events
+    monkeypatch.setattr(fe, "_pinned", lambda *a, **k: None)
+    bisected = cb.sweep(fw, "P", values, out=tmp_path / "b").events
+    assert len(located) == len(bisected) > 0
+    assert list(located["kind"]) == list(bisected["kind"])
+    assert np.abs(located["P"].to_numpy() - bisected["P"].to_numpy()).max() < 1e-6

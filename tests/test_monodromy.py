@@ -226,3 +226,17 @@ def test_monodromy_generic_set_tracks_to_a_target_as_the_total_degree_one():
     theirs, rep2 = track(ps, reference, target)
     assert rep.lost == rep2.lost == 0 and rep.finite == rep2.finite == len(points)
     assert same_sets(ours.points, theirs.points, 1e-7)
+
+
+def test_roots_that_stop_coming_for_a_set_time_are_stagnation(monkeypatch):
+    """Edges that each still find a root now and then never stall by count: the roots not
+    growing by STALL_GAIN within STALL_SECONDS (here 0 s) is stagnation too, incomplete, with
+    the count it has."""
+    monkeypatch.setattr(mono, "STALL_SECONDS", 0.0)
+    stalled = mono.monodromy_generic(parametric_system(ZFL["case1"]), SEED, trace_tol=0.0)
+    assert not stalled.complete
+    assert (
+        stalled.reason.startswith("stagnation: ") and "roots gained in the last" in stalled.reason
+    )
+    with pytest.raises(cb.SolverError, match="stagnation"):
+        stalled.generic_set("incomplete")

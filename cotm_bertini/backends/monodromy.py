@@ -93,6 +93,11 @@ DISTINCT = 1e-7  # two roots closer than this (relative, as coincident_rows) are
 POLISHED = 1e-10  # a Newton-polished endpoint whose last step (relative) is above this: failed
 TRACE_TOL = 1e-8  # the trace test passes when the relative defect of affinity is below this
 MAX_STALL = 5  # fresh edges in a row that find no new root: stagnation (as HC.jl's default)
+# ... or this long without the roots growing by STALL_GAIN: stagnation too (a large fibre whose
+# edges each still find a root now and then: a rigid body on a ball joint sat at 1,578 to
+# 1,584 roots for ten minutes, and the edge count never stalled)
+STALL_SECONDS = 240.0
+STALL_GAIN = 0.01
 MAX_EDGES = 64  # edges at most, whatever happens
 FIRST_EDGES = 3  # edges made at the start: the straight one and two detours (more are added
 # when every root has been along every edge and the trace test still fails)
@@ -320,6 +325,7 @@ class _Graph:
     retracked: int = 0
     idle: int = 0  # fresh edges in a row that found no new root
     resumed: int = 0  # roots read from a checkpoint
+    mark: tuple[int, float] = (0, 0.0)  # (roots, when): the last time they grew by STALL_GAIN
     notes: list[str] = field(default_factory=list)
 
     def count(self, batch: Tracked, what: str) -> None:
@@ -463,15 +469,47 @@ def _explore(
     """Monodromy on the graph until the trace test passes: (trace residual, complete, reason).
     `limits`: (max_stall, max_edges, trace_tol). A round sends every unpaired root along every
     edge; a fresh edge is added when nothing is unpaired and the test still fails; `max_stall`
-    fresh edges in a row without a new root is stagnation: reported incomplete. `save(g)` is
-    called after every chunk of paths and every round (the checkpoint)."""
-    max_stall, max_edges, tol = limits
+    fresh edges in a row without a new root is stagnation, and so are STALL_SECONDS without
+    STALL_GAIN more roots: reported incomplete (the caller falls back or stops, and says so).
+    `save(g)` is called after every chunk of paths and every round (the checkpoint)."""
 
     def after(graph: _Graph, paths: int) -> None:
         save(graph)
-        note = f"{len(graph.nodes[0])} roots, {len(graph.detours)} edges"
+        note = (f"{len(graph.nodes[0])} roots, {len(graph.detours)} edges; time left not known "
+                "(it ends when the trace test passes, or when the roots stop coming)")  # fmt: skip
         report.update(paths, note=note)
+        stalled = _stalled(graph)
+        if stalled:
+            raise _Stalled(stalled)
 
+    try:
+        return _rounds(aug, g, seed, limits, report, save, after)
+    except _Stalled as why:
+        save(g)
+        return float("nan"), False, f"{why} (the trace test not run again)"
+
+
+class _Stalled(Exception):
+    """The roots stopped growing for STALL_SECONDS: stagnation, said why."""
+
+
+def _stalled(g: _Graph) -> str:
+    """Why the monodromy is stagnating ('' while its roots still grow by STALL_GAIN within
+    STALL_SECONDS)."""
+    n, now = len(g.nodes[0]), time.perf_counter()
+    roots, since = g.mark
+    if not since or n >= roots * (1.0 + STALL_GAIN) + 1:
+        g.mark = (n, now)
+        return ""
+    if now - since <= STALL_SECONDS:
+        return ""
+    return (f"stagnation: {n - roots} roots gained in the last {now - since:.0f} s "
+            f"({n} in all; less than {STALL_GAIN:.0%} more)")  # fmt: skip
+
+
+def _rounds(aug: Augmented, g: _Graph, seed: int, limits: tuple, report, save, after) -> tuple:
+    """_explore's rounds (see there): (trace residual, complete, reason)."""
+    max_stall, max_edges, tol = limits
     while True:
         before, found = g.paths, 0
         for k in range(len(g.detours)):

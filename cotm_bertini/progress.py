@@ -80,7 +80,8 @@ def say(text: str, force: bool = False) -> None:
 
 
 def duration(seconds: float) -> str:
-    """A time for people: 0.4 s, 45 s, 4 min 10 s, 3.2 h (under a millisecond: 0 s)."""
+    """A time for people: 0.4 s, 45 s, 4 min 10 s, 3.2 h, 4.5 days, 1,400 years (under a
+    millisecond: 0 s)."""
     if seconds < 1e-3:
         return "0 s"
     if seconds < 10:
@@ -90,7 +91,13 @@ def duration(seconds: float) -> str:
     if seconds < 90 * 60:
         minutes, rest = divmod(round(seconds), 60)
         return f"{minutes} min {rest} s" if minutes < 10 else f"{seconds / 60:.0f} min"
-    return f"{seconds / 3600:.1f} h"
+    if seconds < 48 * 3600:
+        return f"{seconds / 3600:.1f} h"
+    days = seconds / 86400
+    if days < 365:
+        return f"{days:.1f} days" if days < 10 else f"{days:.0f} days"
+    years = days / 365.25
+    return f"{years:.1f} years" if years < 10 else f"{years:,.0f} years"
 
 
 def _one(unit: str) -> str:

@@ -261,3 +261,14 @@ def test_a_fraction_s_time_left_is_at_its_recent_rate_and_unknown_when_it_stalls
     clock[0] = 100.0  # 40 s with nothing decided
     assert p.left is None and "time left not known yet" in p.line()
     p.close()
+
+
+def test_a_long_time_left_is_said_in_days_or_years():
+    """A time left of months or millennia (a search whose pace says 12 million hours) reads in
+    days or years, with the same value: hours below two days."""
+    assert progress.duration(3 * 3600) == "3.0 h"
+    assert progress.duration(47 * 3600) == "47.0 h"
+    assert progress.duration(4.5 * 86400) == "4.5 days"
+    assert progress.duration(40 * 86400) == "40 days"
+    assert progress.duration(3 * 365.25 * 86400) == "3.0 years"
+    assert progress.duration(12_428_446 * 3600) == f"{12_428_446 / 24 / 365.25:,.0f} years"

@@ -466,7 +466,7 @@ def _solve_real(
         seeds, descents, regions = _unproved(land, found, unit, settings.seed)
         stability = None
         if settings.only == "stable":
-            found, seeds, stability = _minima_only(land, found, seeds, settings.seed)
+            found, seeds, stability = _minima_only(land, found, seeds, descents, settings.seed)
         groups = land.endpoints(np.vstack([found.roots, seeds]))
     report: dict = {" ".join(taut) or "none": {"excluded": True, "pruned": "bound smoothing",
                     "note": why.note()} for taut, why in pruned.items()}  # fmt: skip
@@ -511,7 +511,7 @@ def _real_status(found, search_info: dict, checks: dict, failure: str | None) ->
     if failure and not any(w.startswith(failure) for w in warnings):
         warnings = (*warnings, f"{failure}: equilibria may be missing")
     status = STATUS_INCOMPLETE if warnings else STATUS_OK
-    if failure and search_info["free_regions"]:
+    if failure and search_info["free_regions"] and failure == checks["morse"].get("failure"):
         # A region of equilibria has no term in the Morse sum: the count says nothing here.
         checks["morse"].update(
             applicable=False, ok=None, reason="a region of equilibria (a node free to float)"
@@ -532,7 +532,7 @@ def _real_status(found, search_info: dict, checks: dict, failure: str | None) ->
     return status, warnings
 
 
-def _minima_only(land, found, seeds: np.ndarray, seed: int | None) -> tuple:
+def _minima_only(land, found, seeds: np.ndarray, descents: dict, seed: int | None) -> tuple:
     """(found, seeds, what was proved) of a search for the stable equilibria alone: its roots
     proved minima or not (backends.minima; those proved not to be dropped, the undecided kept
     with a warning), the seeds Newton found (not proved) kept where their Hessian is positive
@@ -549,8 +549,13 @@ def _minima_only(land, found, seeds: np.ndarray, seed: int | None) -> tuple:
     # The check that shares no code with the search (the Morse count has no use here): local
     # descents from random poses; a minimum they reach that the search did not find joins the
     # rows, and where the search was proved complete that is a contradiction.
-    reached = land.fresh(descent_minima(land, DESCENTS, 0 if seed is None else seed),
-                         np.zeros((0, land.n)))  # fmt: skip
+    reached = (
+        descents["points"]
+        if descents["starts"]
+        else land.fresh(  # (a budget's: made)
+            descent_minima(land, DESCENTS, 0 if seed is None else seed), np.zeros((0, land.n))
+        )
+    )
     missed = land.fresh(reached, np.vstack([found.roots, seeds]))
     seeds = np.vstack([seeds, missed])
     unsure = int((verdict == 0).sum())

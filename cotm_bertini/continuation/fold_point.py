@@ -36,13 +36,14 @@ class Fold:
     null: np.ndarray
 
 
-def locate_fold(fw, param: str, theta: np.ndarray, p_from: float, p_to: float) -> Fold | None:
-    """The fold where the pair of equilibria at chart points theta (2, n) at `p_from` meets (or
-    the one equilibrium theta (1, n) meets its partner, where only minima were looked for), if
+def locate_fold(fw, param: str, cols: dict, rows, p_from: float, p_to: float) -> Fold | None:
+    """The fold where the pair of equilibria `rows` of a solve's columns `cols` at `p_from`
+    meets (or the one equilibrium meets its partner, where only minima were looked for), if
     Newton on the fold system converges to one no farther from p_from than p_to is, twice over;
     else None."""
     plane = ChartPlane(fw, param, param)  # one parameter: both of the plane's axes
-    a, b = np.asarray(theta, dtype=float)[[0, -1]]
+    theta = plane.land(_at(p_from)).chart_points(cols)[np.asarray(rows)]
+    a, b = theta[[0, -1]]
     step = _wrapped(b - a) if not hasattr(plane.land(_at(p_from)), "positions") else b - a
     start = a + 0.5 * step if np.abs(step).max() < 1.0 else a  # two charts apart: one of them
     _, H = plane.derivatives(start[None], _at(p_from))

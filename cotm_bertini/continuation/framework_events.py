@@ -158,11 +158,9 @@ def _pinned(spec, lo: float, hi: float, below, above) -> _Bracket | None:
         return None
     (p_more, more), (p_less, less) = ((lo, below), (hi, above))[:: 1 if start[0] > end[0] else -1]
     pair = _new_rows(spec.model, more.columns, less.columns, meet)
-    land = _landscape(spec, p_more)
-    if land is None or len(pair) != meet:
+    if len(pair) != meet or not _charted(spec):
         return None
-    fold = locate_fold(spec.model, spec.param, land.chart_points(more.columns)[pair],
-                       p_more, p_less)  # fmt: skip
+    fold = locate_fold(spec.model, spec.param, more.columns, pair, p_more, p_less)
     if fold is None or not lo < fold.value < hi:
         return None
     solve, tol = _solver(spec), BISECT_TOL * max(1.0, abs(lo), abs(hi))
@@ -200,12 +198,11 @@ def _real(spec) -> bool:
     return framework_route(spec.model, point_settings(spec)) == "real"
 
 
-def _landscape(spec, value: float):
-    """The real route's landscape of the swept framework at `value`, or None (not on it)."""
-    from ..backends.real_route import covers, landscape
+def _charted(spec) -> bool:
+    """The swept framework has chart angles (a circle, torus or product of spheres)."""
+    from ..backends.real_route import covers
 
-    fw = spec.model.replace(**{spec.param: value})
-    return landscape(fw) if not covers(fw) else None
+    return not covers(spec.model)
 
 
 def _bisect(spec, pa: float, pb: float, below=None) -> _Bracket:

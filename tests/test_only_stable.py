@@ -102,8 +102,7 @@ def test_a_test_that_drops_a_box_with_a_minimum_is_caught(monkeypatch):
 
 def test_what_only_stable_cannot_answer_is_refused():
     """A setting is honoured or refused: the paper's mechanism (Bertini's complex roots), the
-    complex route, a map's continuation grid, a spatial map, a certificate and barriers need every
-    equilibrium."""
+    complex route, a map's continuation grid, a certificate and barriers need every equilibrium."""
     fw = cb.Framework.from_toml(ROOT / "examples" / "chain3.toml")
     with pytest.raises(ParameterError, match="only = 'stable'"):
         cb.solve(cb.Params.case("case3"), only="stable")
@@ -114,10 +113,6 @@ def test_what_only_stable_cannot_answer_is_refused():
     with pytest.raises(ParameterError, match="grid = 'continuation' with only = 'stable'"):
         cb.design_map(fw, "L0", (1.0, 2.0), "weight", (0.0, 0.2), points=3,
                       settings=cb.Settings(only="stable"), grid="continuation")  # fmt: skip
-    prism = cb.Framework.from_toml(ROOT / "examples" / "prism_slack.toml")
-    with pytest.raises(ParameterError, match="a spatial map's fold curves"):
-        cb.design_map(prism, "L0t", (1.2, 2.2), "L0d", (0.2, 0.6), points=3,
-                      settings=cb.Settings(only="stable"))  # fmt: skip
     res = cb.solve(fw, cache=False, only="stable")
     for call in (cb.certify, cb.barriers):
         with pytest.raises(ParameterError, match="only = 'stable'"):

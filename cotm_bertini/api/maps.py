@@ -129,7 +129,11 @@ def design_map(
     say(f"map: fold curves in the window {x} {xr[0]:g}..{xr[1]:g}, {y} {yr[0]:g}..{yr[1]:g}")
     job = (model, x, xr, y, yr, settings, workers)
     aside = _FoldsAside(job) if isinstance(model, Params) and workers > 1 else None
-    if aside is None:
+    after = _folds_after(model, settings or Settings())
+    if after:
+        say(f"map: the stable states searched at each point of a {points} x {points} grid; "
+            "then the fold curves where a minimum vanishes between neighbours")  # fmt: skip
+    elif aside is None:
         folds, fold_record, t_folds = _timed_folds(job)
         say(f"map: {len(folds)} fold points in {duration(t_folds)}; now the stable counts on a "
             f"{points} x {points} grid (a 2-D sweep)")  # fmt: skip
@@ -141,11 +145,16 @@ def design_map(
                    progress=progress)  # fmt: skip
         if aside is not None:
             folds, fold_record, t_folds = aside.result()
+        if after:
+            folds, fold_record, t_folds = _timed_edge_folds(model, sw.columns, (x, xs), (y, ys))
     finally:
         if aside is not None:
             aside.close()
     regions = counts_on_grid(sw.columns, xs, ys, (x, y))
-    t_regions = time.perf_counter() - t1
+    t_regions = time.perf_counter() - t1 - (t_folds if after else 0.0)
+    if after:
+        say(f"map: {len(folds)} fold points traced in {duration(t_folds)} from "
+            f"{fold_record['seeds']} seeds on the grid's edges")  # fmt: skip
     if aside is not None:
         say(f"map: {len(folds)} fold points in {duration(t_folds)} (beside the sweep)")
     pieces = int(folds.curve_id[folds.curve_id >= 0].nunique())
@@ -191,12 +200,6 @@ def grid_route(model, grid: str, settings: Settings) -> str:
             f"grid = 'continuation' with only = {settings.only!r}: continuation follows every "
             "equilibrium from the anchors; the stable ones alone are proved at every grid point "
             "by grid = 'search'"
-        )
-    if settings.only != "all" and real and model.dim == 3:
-        raise ParameterError(
-            f"only = {settings.only!r}: a spatial map's fold curves are traced in chart angles "
-            "from its continuation grid, which follows every equilibrium; map it with "
-            "only='all', or sweep one parameter with only='stable' (every point proved)"
         )
     if grid == "auto" and settings.only != "all":
         return "search"
@@ -294,6 +297,24 @@ def _made_before(model, key: str, axes: tuple[str, str]) -> DesignMap | None:
         f"(made in {duration(record['timings']['total'])}; no new solve)")  # fmt: skip
     record = {**record, "reused": True, "command": sys.argv[:]}
     return DesignMap(model, folds, regions, record, axes)
+
+
+def _folds_after(model, settings: Settings) -> bool:
+    """The map's fold curves come from its grid (catastrophe/edge_folds.py), after it: a
+    framework in space searched for its stable states alone (its fold systems are out of
+    sympy's reach, and its grid holds no saddles to trace them from)."""
+    return not isinstance(model, Params) and model.dim == 3 and settings.only == "stable"
+
+
+def _timed_edge_folds(model, columns: dict, xa: tuple, ya: tuple) -> tuple:
+    """stable_fold_curves of the grid, kept to the window, its record and seconds."""
+    from ..catastrophe.edge_folds import stable_fold_curves
+
+    start = time.perf_counter()
+    (x, xs), (y, ys) = xa, ya
+    folds, record = stable_fold_curves(model, columns, x, xs, y, ys)
+    inside = folds[x].between(xs[0], xs[-1]) & folds[y].between(ys[0], ys[-1])
+    return folds[inside].reset_index(drop=True), record, time.perf_counter() - start
 
 
 def _timed_folds(job: tuple) -> tuple:

@@ -94,6 +94,8 @@ class ChartPlane:
         """(R, cables): each cable's length minus its free length (normalised units; +inf for
         a cable without one): taut where > 0."""
         theta = np.atleast_2d(theta)
+        if not self.cables:  # springs alone (np.stack takes no empty list)
+            return np.zeros((len(theta), 0))
         land = self.land(p)
         d = land.cable_lengths(theta)
         free = {x.name: x.L0 for x in land.links}

@@ -46,6 +46,13 @@ def locate_fold(fw, param: str, cols: dict, rows, p_from: float, p_to: float) ->
     a, b = theta[[0, -1]]
     step = _wrapped(b - a) if not hasattr(plane.land(_at(p_from)), "positions") else b - a
     start = a + 0.5 * step if np.abs(step).max() < 1.0 else a  # two charts apart: one of them
+    return fold_newton(plane, start, p_from, p_to)
+
+
+def fold_newton(plane: ChartPlane, start: np.ndarray, p_from: float, p_to: float) -> Fold | None:
+    """Newton on the fold system of `plane` (one parameter: both its axes) from chart point
+    `start` at p_from, the null vector started at H's softest eigenvector there: the fold, if
+    it converges no farther from p_from than p_to is, twice over; else None."""
     _, H = plane.derivatives(start[None], _at(p_from))
     eig, vec = np.linalg.eigh(H[0])
     v0 = vec[:, np.argmin(np.abs(eig))]

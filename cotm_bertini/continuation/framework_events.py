@@ -69,7 +69,7 @@ def framework_event_records(spec, table) -> list[dict]:
     # A sweep point whose solve is incomplete (an equilibrium at a cable's free length, boxes
     # left undecided) or has a degenerate equilibrium places no bracket end: its counts may be
     # wrong, and an event there would be a fake. Its neighbours bracket what happens instead.
-    usable = [r for r in range(len(order)) if _usable(part[r])]
+    usable = [r for r in range(len(order)) if usable(part[r])]
     events: list[dict] = []
     pairs = [(r, t) for r, t in zip(usable, usable[1:], strict=False)
              if _signature(part[r]) != _signature(part[t])]  # fmt: skip
@@ -100,7 +100,7 @@ def framework_event_records(spec, table) -> list[dict]:
     return sorted(events, key=lambda e: (e[param], e["kind"], e["branches"]))
 
 
-def _usable(cols) -> bool:
+def usable(cols) -> bool:
     """A sweep point's solve is complete and has no degenerate equilibrium."""
     status = set(np.asarray(cols["status"], dtype=object).tolist())
     kind = np.asarray(cols["kind"], dtype=object)[np.asarray(cols["physical"], dtype=bool)]
@@ -157,7 +157,7 @@ def _pinned(spec, lo: float, hi: float, below, above) -> _Bracket | None:
     if abs(start[0] - end[0]) != meet or below.status != "ok" or above.status != "ok":
         return None
     (p_more, more), (p_less, less) = ((lo, below), (hi, above))[:: 1 if start[0] > end[0] else -1]
-    pair = _new_rows(spec.model, more.columns, less.columns, meet)
+    pair = new_rows(spec.model, more.columns, less.columns, meet)
     if len(pair) != meet or not _charted(spec):
         return None
     fold = locate_fold(spec.model, spec.param, more.columns, pair, p_more, p_less)
@@ -279,7 +279,7 @@ def _switches(spec, b: _Bracket) -> list[tuple[Switch, list[int]]]:
     fw, param = spec.model, spec.param
     ends = [(b.lo, b.below.columns), (b.hi, b.above.columns)]
     (p_more, more), (p_less, less) = ends if n_lo > n_hi else ends[::-1]
-    take = _new_rows(fw, more, less, abs(n_hi - n_lo))
+    take = new_rows(fw, more, less, abs(n_hi - n_lo))
     solve, warm = _solver(spec), b.below.warm
     tol = BISECT_TOL * max(1.0, abs(b.lo), abs(b.hi))
     width = b.hi - b.lo + tol
@@ -425,7 +425,7 @@ def _describe(spec, b: _Bracket, grids: tuple[dict, dict], switches: list, note:
     value = 0.5 * (b.lo + b.hi) if b.located is None else b.located
     bracket = b.hi - b.lo
     head = {param: value, "refined": b.refined, "bracket": bracket, **span}
-    take = _new_rows(fw, more, less, change) if change else _closest_to_zero(lo_cols, 1)
+    take = new_rows(fw, more, less, change) if change else _closest_to_zero(lo_cols, 1)
     if change and not switches:
         third = _third_branch(fw, more, less, take) if change == 2 else None
         if third is None and change == 2 and b.estimate is not None:  # a fold: extrapolated
@@ -519,7 +519,7 @@ def _closest_to_zero(cols, count: int) -> np.ndarray:
     return physical[np.argsort(np.nan_to_num(eig, nan=np.inf), kind="stable")[:count]]
 
 
-def _new_rows(fw, more, less, count: int) -> np.ndarray:
+def new_rows(fw, more, less, count: int) -> np.ndarray:
     """The `count` physical rows of `more` farthest in pose (and link lengths) from every
     physical row of `less`."""
     mine = np.flatnonzero(np.asarray(more["physical"], dtype=bool))

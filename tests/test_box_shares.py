@@ -124,9 +124,9 @@ def test_workers_honoured_or_refused(tmp_path):
         cb.Settings(workers=2, scheduler="tcp://h:1")
     with pytest.raises(cb.ParameterError, match=r"workers = 2: the paper's mechanism"):
         cb.solve(cb.Params(), workers=2, cache=False)
-    fourbar = cb.Framework.from_toml(ROOT / "examples" / "fourbar.toml")  # a closed loop
+    fivebar = cb.Framework.from_toml(ROOT / "tests" / "fixtures" / "fivebar.toml")  # 2 DOF loop
     with pytest.raises(cb.ParameterError, match=r"workers = 2: .* complex route of"):
-        cb.solve(fourbar, workers=2, cache=False)
+        cb.solve(fivebar, workers=2, cache=False)
     out = tmp_path / "sweeps"
     fw = cb.Framework.from_toml(FILE)
     with pytest.raises(cb.ParameterError, match=r"workers = 2 in the settings: a sweep or map"):

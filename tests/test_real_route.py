@@ -367,15 +367,15 @@ def test_route_real_for_the_papers_mechanism_refuses_what_it_cannot_honour(tmp_p
         cb.sweep(cb.Params(), "L01", [0.0, 1.0], route="real", out=tmp_path)
     with pytest.raises(cb.ParameterError, match="route = 'real': map"):
         cb.design_map(cb.Params(), (0, 14), (0, 14), 3, settings=cb.Settings(route="real"))
-    fourbar = cb.Framework.from_toml(ROOT / "examples" / "fourbar.toml")
-    with pytest.raises(cb.ParameterError, match="route = 'real'.*closed loop"):
-        cb.sweep(fourbar, "L0", [0.4, 0.5], route="real", out=tmp_path)
+    fivebar = cb.Framework.from_toml(ROOT / "tests" / "fixtures" / "fivebar.toml")
+    with pytest.raises(cb.ParameterError, match="route = 'real'.*1 closing pin over 4 bodies"):
+        cb.sweep(fivebar, "L0", [0.4, 0.5], route="real", out=tmp_path)
     assert not list(tmp_path.iterdir())
 
 
 def test_route_real_is_refused_where_it_does_not_cover_the_space():
-    fw = cb.Framework.from_toml(ROOT / "examples" / "fourbar.toml")
-    with pytest.raises(cb.ParameterError, match="route = 'real'.*closed loop"):
+    fw = cb.Framework.from_toml(ROOT / "tests" / "fixtures" / "fivebar.toml")
+    with pytest.raises(cb.ParameterError, match="route = 'real'.*1 closing pin over 4 bodies"):
         cb.solve(fw, route="real")
     with pytest.raises(cb.ParameterError, match="route = 'bogus'"):
         cb.Settings(route="bogus")

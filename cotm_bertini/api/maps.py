@@ -126,19 +126,23 @@ def design_map(
     if grid == "continuation":
         return _chart_design_map(model, (x, xr, xs), (y, yr, ys), settings, workers, key)
     t0 = time.perf_counter()
-    say(f"map: fold curves in the window {x} {xr[0]:g}..{xr[1]:g}, {y} {yr[0]:g}..{yr[1]:g}")
     job = (model, x, xr, y, yr, settings, workers)
     aside = _FoldsAside(job) if isinstance(model, Params) and workers > 1 else None
     after = _folds_after(model, settings or Settings())
+    window = f"{x} {xr[0]:g}..{xr[1]:g}, {y} {yr[0]:g}..{yr[1]:g}"
     if after:
-        say(f"map: the stable states searched at each point of a {points} x {points} grid; "
-            "then the fold curves where a minimum vanishes between neighbours")  # fmt: skip
+        say(
+            f"map: the stable states searched at each point of a {points} x {points} grid over "
+            f"{window}; then the fold curves where a minimum vanishes between neighbours"
+        )
     elif aside is None:
+        say(f"map: fold curves in the window {window}")
         folds, fold_record, t_folds = _timed_folds(job)
         say(f"map: {len(folds)} fold points in {duration(t_folds)}; now the stable counts on a "
             f"{points} x {points} grid (a 2-D sweep)")  # fmt: skip
     else:
-        say(f"map: ... and beside them the stable counts on a {points} x {points} grid")
+        say(f"map: fold curves in the window {window}, and beside them the stable counts on a "
+            f"{points} x {points} grid")  # fmt: skip
     t1 = time.perf_counter()
     try:
         sw = sweep(model, x, xs, settings, param2=y, values2=ys, workers=workers,
@@ -157,24 +161,34 @@ def design_map(
             f"{fold_record['seeds']} seeds on the grid's edges")  # fmt: skip
     if aside is not None:
         say(f"map: {len(folds)} fold points in {duration(t_folds)} (beside the sweep)")
-    pieces = int(folds.curve_id[folds.curve_id >= 0].nunique())
+    record = _map_record(model, ((x, xr), (y, yr)), points, (folds, fold_record), sw, regions)
+    record["timings"] = {"folds": t_folds, "regions": t_regions, **record["timings"],
+                         "total": time.perf_counter() - t0}  # fmt: skip
+    _keep(key, folds, regions, record)
+    return DesignMap(model, folds, regions, record, (x, y))
+
+
+def _map_record(model, axes: tuple, points: int, folds: tuple, sw, regions) -> dict:
+    """A searched map's record (run.json): window, fold counts, the sweep behind it, and for a
+    framework the completeness check (timed)."""
+    (x, xr), (y, yr) = axes
+    folds, fold_record = folds
+    t0 = time.perf_counter()
     record = {
         "params": model.as_dict(), "window": {x: list(xr), y: list(yr)}, "axes": [x, y],
-        "points": points, "fold_points": len(folds), "fold_curves": pieces,
-        "cusps": int((folds.kind == "cusp").sum()),
-        "timings": {"folds": t_folds, "regions": t_regions},
+        "points": points, "fold_points": len(folds),
+        "fold_curves": int(folds.curve_id[folds.curve_id >= 0].nunique()),
+        "cusps": int((folds.kind == "cusp").sum()), "timings": {},
         "sweep_folder": str(sw.folder), "sweep_status": sw.status, "command": sys.argv[:],
+        "reused": False,
     }  # fmt: skip
     if isinstance(model, Params):
         record.update(certificate=fold_record, status=sw.status)
     else:
         record.update(framework=model.name, fold_record=fold_record)
         record.update(explained(regions, folds, (x, y), sw.status))
-        record["timings"]["check"] = time.perf_counter() - t1 - t_regions
-    record["timings"]["total"] = time.perf_counter() - t0
-    record["reused"] = False
-    _keep(key, folds, regions, record)
-    return DesignMap(model, folds, regions, record, (x, y))
+        record["timings"]["check"] = time.perf_counter() - t0
+    return record
 
 
 GRIDS = ("auto", "search", "continuation")

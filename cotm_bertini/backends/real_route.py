@@ -34,6 +34,7 @@ from ..model.intervals import Interval, stack
 from .boxes import MIN_WIDTH, SHORT, BoxSearch, cover, distinct, domain, search, search_each
 from .cones import ConeParts
 from .endpoints import Endpoints
+from .loops import ClosingPin, single_loop
 from .links import (
     EITHER,
     SLACK,
@@ -64,7 +65,7 @@ def covers(fw: Framework) -> str:
     if fw.dim == 3:
         return sphere_chain(fw)[1]
     if not layout(fw).is_torus:
-        return "a closed loop, a free body or a free node (not a circle or torus of angles)"
+        return single_loop(fw)
     return ""
 
 
@@ -104,7 +105,9 @@ def moved_landscape(land, fw: Framework, slots: dict):
 
 
 class TorusFramework:
-    """V of a planar framework pinned in an open chain, over boxes of its body angles."""
+    """V of a planar framework pinned in an open chain, over boxes of its body angles; or, for
+    one closing a single loop (backends.loops), the system F whose roots are V's critical points
+    on the loop's curve of poses, in the same angles."""
 
     only = "all"  # which critical points a search of it looks for (`landscape`)
 
@@ -122,7 +125,8 @@ class TorusFramework:
                              and not x.cable]  # fmt: skip
         # backends.cones decides boxes through springs' cones (a spring's end moves in the
         # plane as the angles turn: two or more of them)
-        self.cone_sets = self.n >= fw.dim
+        self.loop = None if layout(fw).is_torus else ClosingPin(self.full)
+        self.cone_sets = self.n >= fw.dim and self.loop is None  # (cones: of grad V, not F)
         self.member: np.ndarray | None = None  # a family's view: each box's member (rows)
         self.family: TorusFamily | None = None
 
@@ -196,6 +200,15 @@ class TorusFramework:
         return dds, slopes, first[len(self.links) * per :], rs, drs
 
     def enclose(self, box: Interval) -> tuple[Interval, Interval, dict]:
+        """(squared lengths of the free-length springs, grad V, the cables' states) per box; a
+        loop's F in place of grad V (backends.loops)."""
+        lengths, grad, states = self.enclose_v(box)
+        if self.loop is not None:
+            X = self.pose(self.full, self.trig(box))
+            grad = self.loop.enclose(ball_module(self.full), X, self.P, grad)
+        return lengths, grad, states
+
+    def enclose_v(self, box: Interval) -> tuple[Interval, Interval, dict]:
         """(squared lengths of the free-length springs, grad V, the cables' states) per box.
         A spring's term is also enclosed through its cone (cone_term): finite where its
         length may be 0, and the two enclosures met where both hold."""
@@ -252,7 +265,16 @@ class TorusFramework:
         return ConeParts(A, J_s, r_s, kl0, H, Interval(lo, hi))
 
     def hessian(self, box: Interval, states: dict) -> Interval:
-        """The hull of the Hessians of every taut set each box allows (B, n, n)."""
+        """The hull of the Hessians of every taut set each box allows (B, n, n); a loop's
+        Jacobian of F (backends.loops)."""
+        hess = self.hessian_v(box, states)
+        if self.loop is None:
+            return hess
+        X = self.pose(self.full, self.trig(box))
+        return self.loop.jacobian(ball_module(self.full), X, self.P, self.enclose_v(box)[1], hess)
+
+    def hessian_v(self, box: Interval, states: dict) -> Interval:
+        """The hull of V's Hessians of every taut set each box allows (B, n, n)."""
         m, count = self.n, box.lo.shape[0]
         trig = self.trig(box)
         lo, hi = np.full((count, m, m), np.inf), np.full((count, m, m), -np.inf)
@@ -274,7 +296,16 @@ class TorusFramework:
 
     def derivatives(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """grad V and its Hessian at points (R, n angles) in double precision, from the
-        generated numpy code (Newton's steps; each point's Hessian that of its taut set)."""
+        generated numpy code (Newton's steps; each point's Hessian that of its taut set); a
+        loop's F and its Jacobian."""
+        grad, hess = self.derivatives_v(x)
+        if self.loop is None:
+            return grad, hess
+        X = self._numeric_pose(self.full, x)
+        return self.loop.numeric(X, self._P_numeric(len(x)), grad, hess)
+
+    def derivatives_v(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """grad V and its Hessian at points (R, n angles) (`derivatives` of an open chain)."""
         P = self._P_numeric(len(x))
         first = self.full.numeric.first_order(self._numeric_pose(self.full, x), P)
         dim, m, per = self.fw.dim, self.n, self.fw.dim + self.fw.dim * self.n
@@ -302,6 +333,14 @@ class TorusFramework:
                                        P[rows])  # fmt: skip
                 hess[rows] = columns(h, len(rows)).reshape(-1, m, m)
         return grad, hess
+
+    def _multipliers(self, angles: np.ndarray) -> np.ndarray:
+        """The closing pin's multipliers at poses on the loop (R, 2), V as its taut set there
+        has it (the pin's Jacobian is the same in every taut set's system: the full one's)."""
+        X = self._numeric_pose(self.full, angles)
+        P = self._P_numeric(len(angles))
+        grad, _ = self.derivatives_v(angles)
+        return self.loop.pin_multipliers(X, P, grad)
 
     def _numeric_pose(self, fs: FrameworkSystem, x: np.ndarray) -> np.ndarray:
         index = {v: j for j, v in enumerate(fs.ps.variables)}
@@ -355,6 +394,8 @@ class TorusFramework:
             elif head == "w":
                 x = links[rest]
                 values[:, k] = x.k * (1.0 - x.L0 / d[rest][rows])
+            elif head == "mu" and self.loop is not None:
+                values[:, k] = self._multipliers(angles)[:, self.loop.multipliers.index(v)]
             else:
                 raise ValueError(f"the real route has no value for unknown {v}")
         return found_endpoints(fs.ps.variables, values, rows)

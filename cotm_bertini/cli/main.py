@@ -160,11 +160,13 @@ def _map_parser(sub) -> None:
     )
     add_params(m)
     add_settings(m)
+    add_only(m)
     _window_options(m, points=101)
     m.add_argument("--grid", choices=("auto", "search", "continuation"), default="auto",
                    help="search: every grid point solved; continuation: a framework on the real "
                    "route, anchors searched and equilibria followed in chart angles; auto "
-                   "(default): continuation for a spatial framework on the real route")  # fmt: skip
+                   "(default): continuation for a spatial framework on the real route, search "
+                   "with --only stable")  # fmt: skip
     m.add_argument("--out", metavar="DIR", default="runs/map", help="default runs/map")
     m.add_argument("--no-plots", action="store_true", help="skip map.png/svg")
     m.add_argument("--html", action="store_true", help=HTML_HELP)

@@ -277,7 +277,7 @@ def settings_from(args: argparse.Namespace) -> Settings:
 
 
 def add_only(p: argparse.ArgumentParser) -> None:
-    """--only: every equilibrium, or the stable ones alone (a solve or a sweep)."""
+    """--only: every equilibrium, or the stable ones alone (a solve, a sweep or a map)."""
     p.add_argument(
         "--only",
         choices=("all", "stable"),

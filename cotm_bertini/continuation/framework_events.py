@@ -69,9 +69,9 @@ def framework_event_records(spec, table) -> list[dict]:
     # A sweep point whose solve is incomplete (an equilibrium at a cable's free length, boxes
     # left undecided) or has a degenerate equilibrium places no bracket end: its counts may be
     # wrong, and an event there would be a fake. Its neighbours bracket what happens instead.
-    usable = [r for r in range(len(order)) if usable(part[r])]
+    kept = [r for r in range(len(order)) if usable(part[r])]
     events: list[dict] = []
-    pairs = [(r, t) for r, t in zip(usable, usable[1:], strict=False)
+    pairs = [(r, t) for r, t in zip(kept, kept[1:], strict=False)
              if _signature(part[r]) != _signature(part[t])]  # fmt: skip
     # Each bisection probe is a full solve (minutes on a large framework, more when a probe
     # needs another generic set): said as it goes, after the sweep's last point.

@@ -23,6 +23,7 @@ from .backends.crossings import in_solve
 from .backends.endpoints import Endpoints
 from .errors import ParameterError
 from .model.compiled import parametric_system
+from .model.framework.structure import layout as model_layout
 from .params import Params
 from .settings import Settings, Tolerances
 
@@ -360,6 +361,12 @@ def check_route(model, settings: Settings, what: str = "solve") -> None:
             "on the complex route, every critical point (its stable rows: result.stable)"
         )
     if not isinstance(model, Params):
+        if settings.only != "all" and model.dim == 2 and model_layout(model).closing_pins:
+            raise ParameterError(
+                f"only = {settings.only!r}: not yet for a closed loop ({model.name}): its "
+                "search is for every critical point on the loop (the stable rows: "
+                "result.stable)"
+            )
         if framework_route(model, settings) == "complex" and workers:
             raise ParameterError(
                 f"workers = {settings.workers!r}: local workers share the real route's boxes; "

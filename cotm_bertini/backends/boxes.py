@@ -546,7 +546,10 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, testing) -
         near = (near | ~smooth) & ~aside & ~free.any(axis=1)
     decided, later = np.zeros(len(lo), dtype=bool), np.zeros(len(lo), dtype=bool)
     decided[gone] = True
-    test = np.flatnonzero(~aside & (smooth | cones) & ~gone)  # grad V finite through cones
+    off = _off_loop(land, grad)
+    decided |= off
+    aside &= ~off
+    test = np.flatnonzero(~aside & (smooth | cones) & ~gone & ~off)  # grad V finite through cones
     n = lo.shape[1]
     found = (rows[:0], np.zeros((0, n)), np.zeros((0, 2 * n)), np.zeros(0, dtype=bool))
     pieces = (rows[:0], np.zeros((0, 4 * n)))
@@ -594,6 +597,16 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, testing) -
         np.vstack([once[1], twice[1]])), np.concatenate([once[2], twice[2]]),
         rows[later], (lo[later], hi[later]), *pieces, rows[small & edge], *peaks,
     )  # fmt: skip
+
+
+def _off_loop(land: BoxLandscape, grad: Interval) -> np.ndarray:
+    """The boxes a loop's closure excludes (backends.loops: F's first components are the
+    closing pin's mismatch, finite where a spring's 1/d makes the rest unbounded): off the
+    loop's curve of poses, whether a spring may be short there or not."""
+    loop = getattr(land, "loop", None)
+    if loop is None:
+        return np.zeros(len(grad.lo), dtype=bool)
+    return ~grad[:, : loop.constraints].contains_zero().all(axis=1)
 
 
 def _enclosed(land: BoxLandscape, box: Interval) -> tuple:

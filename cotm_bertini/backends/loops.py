@@ -59,6 +59,8 @@ class ClosingPin:
     constraint_values and constraint_jacobian of its system (`fs`) and V's gradient and
     Hessian as the torus of its body angles gives them."""
 
+    constraints = 2  # F's first components: the closing pin's mismatch
+
     def __init__(self, fs):
         self.fs = fs
         self.multipliers = [v for v in fs.ps.variables if v.startswith("mu_")]

@@ -545,7 +545,9 @@ def descent_minima(land, starts: int, seed: int, steps: int = 200) -> np.ndarray
     each shortened until V's first-order decrease is kept (no energy is evaluated: the step
     is damped instead); the ends with |grad V| < 1e-10 and a positive definite Hessian. Not a
     proof: evidence, for a search stopped by its budget, that its rows hold every minimum the
-    descents find."""
+    descents find. None on a loop (its landscape's derivatives are F's, not V's)."""
+    if getattr(land, "loop", None) is not None:
+        return np.zeros((0, land.n))
     rng = np.random.default_rng(seed)
     lo, hi = domain(land, 8)
     pick = rng.integers(0, len(lo), starts)

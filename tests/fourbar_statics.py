@@ -64,8 +64,14 @@ class FourBar:
     def toml(self, name: str) -> str:
         """The mechanism as a framework file."""
         r = lambda v: repr(float(v))  # noqa: E731
-        out = [f'name = "{name}"', "dim = 2", "", "[ground]", f"A = [{r(self.A[0])}, {r(self.A[1])}]",
-               f"D = [{r(self.D[0])}, {r(self.D[1])}]"]  # fmt: skip
+        out = [
+            f'name = "{name}"',
+            "dim = 2",
+            "",
+            "[ground]",
+            f"A = [{r(self.A[0])}, {r(self.A[1])}]",
+            f"D = [{r(self.D[0])}, {r(self.D[1])}]",
+        ]
         out += [f"G{i} = [{r(a[0])}, {r(a[1])}]" for i, (*_, a, _k, _L) in enumerate(self.links)]
         out += ["", "[bodies.crank]", "a = [0.0, 0.0]", f"b = [{r(self.crank)}, 0.0]", "",
                 "[bodies.coupler]", "b = [0.0, 0.0]", f"c = [{r(self.coupler)}, 0.0]",

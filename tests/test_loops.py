@@ -49,7 +49,7 @@ def _check(fb: FourBar, res) -> None:
             assert abs(_slope(fb, np.radians(a), branch)) < 1e-7, (branch, a)
 
 
-def test_the_sprung_four_bar_is_its_statics(tmp_path):
+def test_the_sprung_four_bar_is_its_statics():
     """The four-bar of the fixture: every equilibrium on both assembly branches, proved."""
     path = ROOT / "tests" / "fixtures" / "fourbar_springs.toml"
     text = "".join(ln for ln in path.read_text().splitlines(True) if not ln.startswith("#"))

@@ -121,8 +121,9 @@ class ClosingPin:
         A = np.stack([np.stack([np.broadcast_to(np.asarray(v, dtype=float), (count,))
                                 for v in row], axis=1) for row in J], axis=1)  # fmt: skip
         # (R, 2, 3): solve A^T mu = -g per point
-        return np.stack([np.linalg.lstsq(a.T, -b, rcond=None)[0] for a, b in zip(A, g,
-                                                                                 strict=True)])
+        return np.stack(
+            [np.linalg.lstsq(a.T, -b, rcond=None)[0] for a, b in zip(A, g, strict=True)]
+        )
 
 
 def _interval(v, count: int) -> Interval:

@@ -34,7 +34,6 @@ from ..model.intervals import Interval, stack
 from .boxes import MIN_WIDTH, SHORT, BoxSearch, cover, distinct, domain, search, search_each
 from .cones import ConeParts
 from .endpoints import Endpoints
-from .loops import ClosingPin, single_loop
 from .links import (
     EITHER,
     SLACK,
@@ -54,6 +53,7 @@ from .links import (
     squared_bounds,
     taut_groups,
 )
+from .loops import ClosingPin, single_loop
 from .spheres import SphereFramework
 
 ONLY = ("all", "stable")  # what a search looks for: every critical point, or the minima

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..backends.crossings import in_solve
+from ..backends.free_nodes import free_nodes_only
 from ..backends.loops import single_loop
 from ..model.framework.compiled import FrameworkSystem, framework_system, slot_vector
 from ..model.framework.spec import Framework
@@ -154,9 +155,13 @@ def completeness(
 def configuration_space(fw: Framework) -> tuple[list[str], str]:
     """The factors of the configuration space when it is a closed manifold the Morse count
     applies to (S1 per planar body and SO3 per spatial body of a pinned open chain, a sphere per
-    node hung from a placed point by one bar, "loop" for a four-bar's circles), else ([], why
-    not)."""
+    node hung from a placed point by one bar, "loop" for a four-bar's circles, R2 or R3 per node
+    held by springs and cables alone), else ([], why not)."""
     lay = layout(fw)
+    if not free_nodes_only(fw):
+        # Nodes held by springs and cables alone: the product of balls backends.free_nodes
+        # bounds them in, where the gradient points out at the boundary (chi 1).
+        return ["R2" if fw.dim == 2 else "R3" for _ in lay.free_nodes], ""
     if lay.closing_pins and not lay.translations and not single_loop(fw):
         # One loop of one degree of freedom: where no pose is singular its poses are one or
         # two circles (a four-bar's assembly branches), Euler characteristic 0 either way.
@@ -210,7 +215,8 @@ def morse_count(fw: Framework, table: dict, continua: list = (), near_cones=None
     if collapsible and (cones is None or aside) and not torus2:
         return {"applicable": False, "ok": None, "reason": f"spring {collapsible[0]} may reach "
                 "zero length (a cone point of V the count cannot place)"}  # fmt: skip
-    chi = int(np.prod([{"S1": 0, "SO3": 0, "S2": 2, "loop": 0}[f] for f in factors]))
+    chi = int(np.prod([{"S1": 0, "SO3": 0, "S2": 2, "loop": 0, "R2": 1, "R3": 1}[f]
+                       for f in factors]))  # fmt: skip
     phys = np.asarray(table["physical"], dtype=bool)
     kinds = np.asarray(table["kind"], dtype=object)[phys]
     index = np.asarray(table["index"], dtype=int)[phys]

@@ -380,15 +380,17 @@ def _ordered(roots: np.ndarray) -> np.ndarray:
     return np.lexsort(roots.T[::-1]) if len(roots) else np.zeros(0, dtype=np.int64)
 
 
-def distinct(points: np.ndarray, apart: float) -> np.ndarray:
+def distinct(points: np.ndarray, apart: float, wrap: bool = True) -> np.ndarray:
     """The indices of the points (R, n angles) not within `apart` rad (on the torus: angles
-    modulo 2 pi) of an earlier one."""
+    modulo 2 pi; without `wrap`, plain coordinates) of an earlier one."""
+    period = TWO_PI if wrap else np.inf
     keep: list[int] = []
     for i in range(len(points)):
         if not keep:
             keep.append(i)
             continue
-        gap = np.abs((points[keep] - points[i] + math.pi) % TWO_PI - math.pi).max(axis=1)
+        diff = points[keep] - points[i]
+        gap = np.abs((diff + math.pi) % period - math.pi if wrap else diff).max(axis=1)
         if gap.min() > apart:
             keep.append(i)
     return np.array(keep, dtype=np.int64)

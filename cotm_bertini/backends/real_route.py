@@ -1,6 +1,8 @@
 """The real route: a framework whose poses form a circle or torus solved on the reals, by the
 branch and bound of `boxes` over its body angles, with no complex generic set (one whose nodes
-hang by bars, a product of spheres, by backends.spheres: `covers` and `landscape` say which).
+hang by bars, a product of spheres, by backends.spheres; a four-bar's loop by backends.loops;
+nodes held by springs and cables alone over their coordinates, backends.free_nodes: `covers`
+and `landscape` say which).
 
 V = sum k/2 (d - L0)^2 over springs + sum k/2 max(d - L0, 0)^2 over cables - the loads' work, so
 grad V = sum w r . dr/dangle + the loads' gradient, w = k (1 - L0/d) for a spring (k at zero free
@@ -27,13 +29,24 @@ import numpy as np
 from ..model.framework.ballcode import ball_module
 from ..model.framework.compiled import FrameworkSystem, framework_system, slot_vector
 from ..model.framework.reach import cable_states, sphere_chain
-from ..model.framework.spec import Framework
+from ..model.framework.spec import Framework, units
 from ..model.framework.structure import layout
 from ..model.framework.units import normalized_slots
 from ..model.intervals import Interval, stack
-from .boxes import MIN_WIDTH, SHORT, BoxSearch, cover, distinct, domain, search, search_each
+from .boxes import (
+    MIN_WIDTH,
+    SHORT,
+    BoxSearch,
+    cover,
+    distinct,
+    domain,
+    initial_boxes,
+    search,
+    search_each,
+)
 from .cones import ConeParts
 from .endpoints import Endpoints
+from .free_nodes import free_nodes_only, reach
 from .links import (
     EITHER,
     SLACK,
@@ -61,7 +74,10 @@ ONLY = ("all", "stable")  # what a search looks for: every critical point, or th
 
 def covers(fw: Framework) -> str:
     """'' where the real route covers the framework's configuration space (a circle or torus
-    of planar bodies' angles, or a product of spheres of nodes hung on bars), else why not."""
+    of planar bodies' angles, a four-bar's loop, a product of spheres of nodes hung on bars,
+    or nodes held by springs and cables alone), else why not."""
+    if not free_nodes_only(fw):
+        return ""
     if fw.dim == 3:
         return sphere_chain(fw)[1]
     if not layout(fw).is_torus:
@@ -86,7 +102,8 @@ def landscape(fw: Framework, only: str = "all") -> TorusFramework | SphereFramew
 def new_landscape(fw: Framework) -> TorusFramework | SphereFramework:
     """The landscape of `fw`, built now (uncached: continuation in chart angles builds one for
     each parameter value it visits, continuation/charts.py)."""
-    return SphereFramework(fw) if fw.dim == 3 else TorusFramework(fw)
+    spheres = fw.dim == 3 and bool(free_nodes_only(fw))
+    return SphereFramework(fw) if spheres else TorusFramework(fw)
 
 
 def moved_landscape(land, fw: Framework, slots: dict):
@@ -107,7 +124,8 @@ def moved_landscape(land, fw: Framework, slots: dict):
 class TorusFramework:
     """V of a planar framework pinned in an open chain, over boxes of its body angles; or, for
     one closing a single loop (backends.loops), the system F whose roots are V's critical points
-    on the loop's curve of poses, in the same angles."""
+    on the loop's curve of poses, in the same angles; or, for nodes held by springs and cables
+    alone (backends.free_nodes), V over boxes of their coordinates within a proved bound."""
 
     only = "all"  # which critical points a search of it looks for (`landscape`)
 
@@ -120,12 +138,13 @@ class TorusFramework:
         self.full = framework_system(fw, self.cables)
         self.n = self.full.local_size
         self.bodies = layout(fw).rotations
+        self.nodes = () if self.bodies else layout(fw).free_nodes  # coordinates, not angles
         self.renumber()
         self.free_springs = [i for i, x in enumerate(self.links) if x.L0 is not None
                              and not x.cable]  # fmt: skip
         # backends.cones decides boxes through springs' cones (a spring's end moves in the
         # plane as the angles turn: two or more of them)
-        self.loop = None if layout(fw).is_torus else ClosingPin(self.full)
+        self.loop = ClosingPin(self.full) if layout(fw).closing_pins else None
         self.cone_sets = self.n >= fw.dim and self.loop is None  # (cones: of grad V, not F)
         self.member: np.ndarray | None = None  # a family's view: each box's member (rows)
         self.family: TorusFamily | None = None
@@ -135,6 +154,8 @@ class TorusFramework:
         self.slots = normalized_slots(self.fw) if slots is None else slots
         self.P = [float(v) for v in slot_vector(self.slots)]
         self.links = links(self.fw, self.full.active, self.slots)
+        if self.nodes:  # the box that holds every equilibrium, at these numbers
+            self.centre, self.radius = reach(self.fw, self.slots)
 
     def structure(self) -> tuple:
         """What a search's arithmetic depends on besides the numbers: frameworks of one
@@ -172,16 +193,37 @@ class TorusFramework:
 
     def pose(self, fs: FrameworkSystem, trig: list) -> list:
         """The solver variables of `fs` over the boxes from each body's (sin, cos) (`trig`; the
-        rest 0: the generated first_order and hessian of a torus read only the rotations)."""
+        rest 0: the generated first_order and hessian of a torus read only the rotations), or
+        each free node's coordinates."""
         index = {v: j for j, v in enumerate(fs.ps.variables)}
         X: list = [0.0] * len(fs.ps.variables)
+        for v, coords in zip(self.nodes, trig if self.nodes else (), strict=True):
+            for a, value in zip("xyz", coords, strict=False):
+                X[index[f"n_{v}_{a}"]] = value
+        if self.nodes:
+            return X
         for b, (s, c) in zip(self.bodies, trig, strict=True):
             X[index[f"s_{b}"]], X[index[f"c_{b}"]] = s, c
         return X
 
     def trig(self, box: Interval) -> list:
-        """(sin, cos) of each body's angle over the boxes."""
+        """(sin, cos) of each body's angle over the boxes (a free node's coordinates)."""
+        if self.nodes:
+            d = self.fw.dim
+            return [tuple(box[:, i * d + a] for a in range(d)) for i in range(len(self.nodes))]
         return [box[:, j].sin_cos() for j in range(len(self.bodies))]
+
+    def domain(self, start: int) -> tuple[np.ndarray, np.ndarray]:
+        """The boxes a search starts from: the torus grid, or for free nodes the cube about
+        the centre that holds every equilibrium, at most start^2 boxes a node."""
+        if not self.nodes:
+            return initial_boxes(self.n, start)
+        per = max(1, int(round((start ** (2 * len(self.nodes))) ** (1 / self.n))))
+        lo = np.tile(self.centre - self.radius, len(self.nodes))
+        edges = lo[None, :] + 2 * self.radius * np.arange(per + 1)[:, None] / per
+        idx = np.indices((per,) * self.n).reshape(self.n, -1).T
+        cols = np.arange(self.n)
+        return edges[idx, cols], edges[idx + 1, cols]
 
     def parts(self, box: Interval) -> tuple[list, list, list, list, list]:
         """Per link its squared length and r . dr/dangle (n), the loads' gradient, and per link
@@ -237,7 +279,10 @@ class TorusFramework:
         the generated first derivatives at the box turned by pi/2, as the loads' are)."""
         dim, m, count = self.fw.dim, self.n, box.lo.shape[0]
         dds, slopes, loads, rs, drs = self.parts(box)
-        _, _, loads2, _, drs2 = self.parts(box + np.pi / 2)
+        if self.nodes:  # straight coordinates: r and the loads' work have no second derivative
+            loads2, drs2 = [0.0] * m, [[0.0] * len(d) for d in drs]
+        else:
+            _, _, loads2, _, drs2 = self.parts(box + np.pi / 2)
         which = np.asarray(self.free_springs)[spring]
         A = matrix([loads], count)[:, 0]
         H = add_diagonal(Interval(np.zeros((count, m, m))), matrix([loads2], count)[:, 0])
@@ -287,7 +332,7 @@ class TorusFramework:
             if not len(rows):
                 continue
             part = len(rows) < count
-            sub = [(s[rows], c[rows]) for s, c in trig] if part else trig
+            sub = [tuple(v[rows] for v in group) for group in trig] if part else trig
             h = ball_module(fs).hessian(self.pose(fs, sub), self._P_rows(rows) if part else self.P)
             h = stack([Interval.of(np.broadcast_to(0.0, (len(rows),))) + v for v in h], axis=1)
             lo[rows] = np.minimum(lo[rows], h.lo.reshape(-1, m, m))
@@ -305,7 +350,12 @@ class TorusFramework:
         return self.loop.numeric(X, self._P_numeric(len(x)), grad, hess)
 
     def derivatives_v(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """grad V and its Hessian at points (R, n angles) (`derivatives` of an open chain)."""
+        """grad V and its Hessian at points (R, n angles) (`derivatives` of an open chain); NaN
+        where a spring has zero length (a free node on its anchor), said by no warning."""
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return self._derivatives_v(x)
+
+    def _derivatives_v(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         P = self._P_numeric(len(x))
         first = self.full.numeric.first_order(self._numeric_pose(self.full, x), P)
         dim, m, per = self.fw.dim, self.n, self.fw.dim + self.fw.dim * self.n
@@ -345,16 +395,31 @@ class TorusFramework:
     def _numeric_pose(self, fs: FrameworkSystem, x: np.ndarray) -> np.ndarray:
         index = {v: j for j, v in enumerate(fs.ps.variables)}
         X = np.zeros((len(x), len(fs.ps.variables)))
+        for i, v in enumerate(self.nodes):
+            for a in range(self.fw.dim):
+                X[:, index[f"n_{v}_{'xyz'[a]}"]] = x[:, i * self.fw.dim + a]
         for j, b in enumerate(self.bodies):
             X[:, index[f"s_{b}"]], X[:, index[f"c_{b}"]] = np.sin(x[:, j]), np.cos(x[:, j])
         return X
 
     def fresh(self, points: np.ndarray, known: np.ndarray) -> np.ndarray:
-        """The points that are neither at a `known` one nor at an earlier one (fresh_points)."""
-        return fresh_points(points, known)
+        """The points that are neither at a `known` one nor at an earlier one (fresh_points;
+        free nodes' coordinates do not wrap)."""
+        return fresh_points(points, known, wrap=not self.nodes)
 
     def chart_points(self, cols: dict) -> np.ndarray:
-        """The chart points (R, n body angles) of a solutions table's rows (`cols`: columns)."""
+        """The chart points (R, n body angles, or free nodes' coordinates in normalised units)
+        of a solutions table's rows (`cols`: columns)."""
+        if self.nodes:
+            scale = units(self.fw)[0]
+            return np.stack(
+                [
+                    np.asarray(cols[f"{v}.{a}"], dtype=float) / scale
+                    for v in self.nodes
+                    for a in "xyz"[: self.fw.dim]
+                ],
+                axis=1,
+            )
         angles = [np.asarray(cols[f"{b}.angle_deg"], dtype=float) for b in self.bodies]
         return np.radians(np.stack(angles, axis=1)).reshape(-1, self.n)
 
@@ -386,7 +451,10 @@ class TorusFramework:
         values = np.zeros((len(rows), len(fs.ps.variables)), dtype=complex)
         for k, v in enumerate(fs.ps.variables):
             head, _, rest = v.partition("_")
-            if head in ("c", "s"):
+            if head == "n":
+                node, _, axis = rest.rpartition("_")
+                values[:, k] = angles[:, self.nodes.index(node) * self.fw.dim + "xyz".index(axis)]
+            elif head in ("c", "s"):
                 a = angles[:, self.bodies.index(rest)]
                 values[:, k] = np.cos(a) if head == "c" else np.sin(a)
             elif head == "d":
@@ -569,12 +637,13 @@ def descent_minima(land, starts: int, seed: int, steps: int = 200) -> np.ndarray
     return x[good]
 
 
-def fresh_points(points: np.ndarray, known: np.ndarray, apart: float = 1e-8) -> np.ndarray:
-    """The points (R, n angles) that are neither within `apart` (rad, on the torus) of a
-    `known` one nor of an earlier one of their own."""
+def fresh_points(points: np.ndarray, known: np.ndarray, apart: float = 1e-8,
+                 wrap: bool = True) -> np.ndarray:  # fmt: skip
+    """The points (R, n angles) that are neither within `apart` (rad, on the torus; without
+    `wrap`, plain coordinates) of a `known` one nor of an earlier one of their own."""
     n = known.shape[1] if known.ndim == 2 else points.shape[1]
     both = np.vstack([known.reshape(-1, n), points.reshape(-1, n)])
-    keep = distinct(both, apart)
+    keep = distinct(both, apart, wrap)
     return both[keep[keep >= len(known)]]
 
 

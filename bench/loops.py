@@ -63,8 +63,11 @@ def main() -> None:
         for route, m in got.items():
             gap = None
             if route == "complex" and m["rows"] == got["real"]["rows"]:
-                diff = [abs((a - b + 180) % 360 - 180) for p, q in zip(m["poses"],
-                        got["real"]["poses"], strict=True) for a, b in zip(p, q, strict=True)]
+                diff = [
+                    abs((a - b + 180) % 360 - 180)
+                    for p, q in zip(m["poses"], got["real"]["poses"], strict=True)
+                    for a, b in zip(p, q, strict=True)
+                ]
                 gap = max(diff, default=0.0)  # fmt: skip
             rows.append({"file": Path(path).name, "route": route, "first_s": m["first"],
                          "later_s": m["later"], "first/later": m["first"] / m["later"],

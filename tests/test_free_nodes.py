@@ -137,3 +137,15 @@ def test_a_pair_of_free_nodes_in_space_is_its_statics():
     res = cb.solve(cb.Framework.from_toml(ROOT / "tests" / "fixtures" / "free_pair.toml"),
                    cache=False)  # fmt: skip
     assert res.status == "ok" and res.morse["ok"] and len(res.physical) == 2
+
+
+def test_a_node_that_could_float_is_refused_on_the_real_route(tmp_path):
+    """A node on cables alone with no load floats over a region of equilibria (all slack), which
+    the search would run down to its smallest boxes: the real route refuses it in one line."""
+    path = tmp_path / "float.toml"
+    path.write_text('name = "float"\ndim = 2\nnodes = ["N"]\n[ground]\na = [0.0, 0.0]\n'
+                    'b = [1.0, 0.0]\n[[cables]]\nname = "ca"\na = "N"\nb = "ground.a"\nk = 1.0\n'
+                    'L0 = 1.0\n[[cables]]\nname = "cb"\na = "N"\nb = "ground.b"\nk = 1.0\n'
+                    "L0 = 1.0\n")  # fmt: skip
+    with pytest.raises(cb.ParameterError, match="node N has no load and 2 link.*float"):
+        cb.solve(cb.Framework.from_toml(path), route="real")

@@ -39,6 +39,15 @@ def free_nodes_only(fw: Framework) -> str:
     loose = [v for v in lay.free_nodes if v not in grounded]
     if loose:
         return f"node {loose[0]} has no spring or cable to the ground (no bound on where it is)"
+    for v in lay.free_nodes:
+        mine = [x for x in fw.links if v in (x.a, x.b)]
+        loaded = any(ld.point == v for ld in fw.loads)
+        # Without a load, a node on cables alone floats over a region where all are slack,
+        # and one on a single spring over a circle or sphere: boxes to the smallest width.
+        if not loaded and (len(mine) < 2 or all(x.kind == "cable" for x in mine)):
+            return (f"node {v} has no load and {len(mine)} link(s), "
+                    f"{'all cables' if all(x.kind == 'cable' for x in mine) else 'one spring'}: "
+                    "it may float over a region of equilibria")  # fmt: skip
     return ""
 
 

@@ -76,11 +76,13 @@ def covers(fw: Framework) -> str:
     """'' where the real route covers the framework's configuration space (a circle or torus
     of planar bodies' angles, a four-bar's loop, a product of spheres of nodes hung on bars,
     or nodes held by springs and cables alone), else why not."""
-    if not free_nodes_only(fw):
-        return ""
+    why = free_nodes_only(fw)
+    lay = layout(fw)
+    if not why or (lay.free_nodes and not (lay.rotations or lay.translations or fw.bars)):
+        return why  # nodes alone: covered, or why not
     if fw.dim == 3:
         return sphere_chain(fw)[1]
-    if not layout(fw).is_torus:
+    if not lay.is_torus:
         return single_loop(fw)
     return ""
 
@@ -544,7 +546,8 @@ def search_frameworks(
     groups: dict[tuple, list[int]] = {}
     out: list = [None] * len(lands)
     for k, land in enumerate(lands):
-        if not isinstance(land, TorusFramework):  # charts of spheres: a search each
+        # charts of spheres, and free nodes (each its own bounding cube): a search each
+        if not isinstance(land, TorusFramework) or land.nodes:
             out[k] = search(land, SHORT, MIN_WIDTH, max_seconds=max_seconds,
                             label=f"real search of {fws[k].name}")  # fmt: skip
             continue

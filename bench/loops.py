@@ -4,7 +4,9 @@ For each file: the first solve in a fresh cache (a process of its own: the deriv
 search and the rows, as a user's first `solve` pays them), then a later solve (same process,
 the derivation cached, no result cache), on the real route (the default) and, with
 `--complex`, on the complex route (its first solve tracks every path of its generic sets).
-Rows, kinds and the status side by side; the largest pose difference between the routes.
+Rows, kinds and the status side by side; the largest pose difference between the routes. Then
+the command line end to end (process start included): the first solve in a fresh cache and
+the median of three later ones.
 
 Benchmarks, not tests: nothing is asserted; figures are printed and written to
 bench/results/loops.csv.
@@ -19,6 +21,7 @@ import os
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 import pandas as pd
@@ -52,6 +55,24 @@ def measure(path: str, route: str) -> dict:
     return json.loads(proc.stdout.strip().splitlines()[-1])
 
 
+def command_line(path: str, repeats: int = 3) -> dict:
+    """`cotm-bertini solve --framework FILE --no-cache --no-plots` end to end (process start
+    included), as a user runs it: the first in a fresh cache, then the median of `repeats`."""
+    exe = str(Path(sys.executable).with_name("cotm-bertini"))
+    with tempfile.TemporaryDirectory(prefix="bench-loops-") as cache:
+        env = {**os.environ, "COTM_CACHE": cache}
+        args = [exe, "solve", "--framework", str(ROOT / path), "--no-cache", "--no-plots",
+                "--quiet", "--out", str(Path(cache) / "runs")]  # fmt: skip
+        walls = []
+        for _ in range(1 + repeats):
+            start = time.perf_counter()
+            subprocess.run(args, env=env, capture_output=True, check=True)
+            walls.append(time.perf_counter() - start)
+    later = sorted(walls[1:])[len(walls[1:]) // 2]
+    return {"file": Path(path).name, "first_s": walls[0], "later_s": later,
+            "first/later": walls[0] / later}  # fmt: skip
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("files", nargs="*", default=list(FILES))
@@ -76,6 +97,9 @@ def main() -> None:
     frame = pd.DataFrame(rows)
     show("closed loops: first and later solve, real and complex routes", frame, {})
     write_csv(frame, "loops")
+    cli = pd.DataFrame([command_line(path) for path in args.files])
+    show("the command line, end to end (real route)", cli, {})
+    write_csv(cli, "loops_cli")
     print(json.dumps({"files": args.files, "complex": args.complex}))
 
 

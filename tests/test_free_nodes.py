@@ -149,3 +149,20 @@ def test_a_node_that_could_float_is_refused_on_the_real_route(tmp_path):
                     "L0 = 1.0\n")  # fmt: skip
     with pytest.raises(cb.ParameterError, match="node N has no load and 2 link.*float"):
         cb.solve(cb.Framework.from_toml(path), route="real")
+
+
+def test_a_node_in_the_plane_on_both_routes_agrees(tmp_path):
+    """A node on a spring of zero free length and two cables in series (tests/test_prune.py's
+    mechanism, with a load): the real route's rows are the complex route's, to 1e-9."""
+    from test_prune import SERIES
+
+    path = tmp_path / "series.toml"
+    path.write_text(SERIES + '\n[[loads]]\nname = "w"\npoint = "N"\nforce = [0.4, -0.3]\n')
+    fw = cb.Framework.from_toml(path)
+    real, cplx = cb.solve(fw, cache=False), cb.solve(fw, cache=False, route="complex")
+    assert "real_search" in real.record["details"] and real.status == cplx.status == "ok"
+    cols = ["N.x", "N.y"]
+    a = real.physical.sort_values(cols)[cols].to_numpy(float)
+    b = cplx.physical.sort_values(cols)[cols].to_numpy(float)
+    assert a.shape == b.shape and np.allclose(a, b, atol=1e-9)
+    assert list(real.physical["kind"]) == list(cplx.physical["kind"])

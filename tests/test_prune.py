@@ -71,13 +71,13 @@ def test_a_pruned_set_is_recorded_and_loses_nothing_physical(tmp_path, monkeypat
     """The solve lists the pruned set with its proof and does not solve it; solved anyway (the
     pruning off), that set's only equilibrium is N = g3 (the spring alone), where c1 is 1.80
     long, beyond its free length 1: not consistent, so the physical rows are the same."""
-    fw = _series(tmp_path)
-    res = cb.solve(fw, cache=False)
+    fw = _series(tmp_path)  # (a free node: the real route's by default; the pruning is the
+    res = cb.solve(fw, cache=False, route="complex")  # complex route's)
     record = res.record["details"]["taut_sets"]["none"]
     assert record["pruned"] == "bound smoothing" and "no pose holds it" in record["note"]
     assert res.record["counts"]["taut_sets_pruned"] == 1
     monkeypatch.setattr(prune_module, "prune", lambda fw, taut: None)
-    full = cb.solve(fw, cache=False)
+    full = cb.solve(fw, cache=False, route="complex")
     assert "tracked" in full.record["details"]["taut_sets"]["none"]
     assert len(full.table) > len(res.table)  # the pruned set's rows, none physical
     cols = ["N.x", "N.y"]
@@ -126,7 +126,7 @@ def test_the_cost_statement_counts_the_pruned_sets_apart(tmp_path, monkeypatch):
 
     monkeypatch.setenv("COTM_CACHE", str(tmp_path / "cache"))
     monkeypatch.setattr(compiled, "_LOADED", {})
-    c = cb.cost(_series(tmp_path), sample=False)
+    c = cb.cost(_series(tmp_path), cb.Settings(route="complex"), sample=False)
     assert len(c.sets) == 3 and c.pruned == 1
     assert "3 taut sets (1 more pruned: no pose holds them)" in c.headline()
 

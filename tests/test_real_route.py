@@ -523,3 +523,17 @@ def test_a_family_covered_together_proves_each_point_as_alone():
         a, b = (r[np.lexsort(r.T[::-1])] for r in (got.roots, alone.roots))
         assert len(a) == len(b) > 0 and np.abs(a - b).max() < 1e-9
         assert got.boxes < alone.boxes and "together first" in got.notes[-1]
+
+
+def test_params_states_the_real_route_s_pace_from_a_sample_search():
+    """cb.cost (params --framework) on the real route runs the search for up to 2 s: a small
+    file's whole search (its time and boxes), a large one's share decided and a lower bound;
+    a solve's own announcement does not sample (sample=None)."""
+    small = cb.cost(cb.Framework.from_toml(ROOT / "examples" / "fourbar.toml"))
+    assert small.search["done"] and small.search["boxes"] > 0
+    assert "a whole search took" in small.headline()
+    big = cb.cost(cb.Framework.from_toml(ROOT / "examples" / "tower.toml"))
+    assert not big.search["done"] and 0 <= big.search["decided"] < 0.05
+    assert "at least about" in big.headline() or "far beyond" in big.headline()
+    quiet = cb.cost(cb.Framework.from_toml(ROOT / "examples" / "tower.toml"), sample=None)
+    assert quiet.search is None

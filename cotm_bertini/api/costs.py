@@ -31,6 +31,7 @@ SAMPLE_FROM = 30.0  # a solve samples the rate when its first guess is beyond th
 # start point first: prism_slack's smallest set spent 56 s there, measured).
 SAMPLE_MAX_PATHS = 5_000
 HOUR = 3600.0  # an estimate beyond this is said plainly, with what to do about it
+REAL_SAMPLE_SECONDS = 2.0  # params: the real route's search, run this long, gives its pace
 
 
 @dataclass(frozen=True)
@@ -67,6 +68,7 @@ class Cost:
     route: str = "total-degree"  # of the generic sets (backends.generic.route_of); "both":
     # `sets` count the total-degree set of the seed, the monodromy one is not counted
     pruned: int = 0  # taut sets no pose can hold (point.pruned_taut_sets): not in `sets`
+    search: dict | None = None  # the real route's sample search (_search_sample), if run
 
     @property
     def paths(self) -> int:
@@ -107,8 +109,8 @@ class Cost:
         if self.route == "real":
             return (
                 f"{self.name}: the real route (a branch and bound over its configuration space, "
-                "real equilibria only, proved complete; no generic set to solve: seconds, not "
-                "paths; --route complex solves every complex root of every taut set instead)"
+                "real equilibria only, proved complete; no generic set to solve; --route complex "
+                "solves every complex root of every taut set instead)" + _paced(self.search)
             )
         solved = [s for s in self.sets if not s.free]
         tracked = [s for s in solved if s.route != "monodromy"]  # paths counted beforehand
@@ -240,7 +242,9 @@ def cost(fw, settings: Settings | None = None, *, sample: bool | None = True) ->
 
     settings = settings or Settings()
     if framework_route(fw, settings) == "real":
-        return Cost(fw.name, (), (settings.seed,), 0.0, "no generic set", False, 0.0, "real")
+        probe = _search_sample(fw) if sample is True else None
+        return Cost(fw.name, (), (settings.seed,), 0.0, "no generic set", False, 0.0, "real",
+                    search=probe)  # fmt: skip
     t0 = time.perf_counter()
     sets, systems, pruned = _sets(fw, settings)
     derive_seconds = time.perf_counter() - t0
@@ -313,6 +317,35 @@ def _sets(fw, settings: Settings) -> tuple[list[SetCost], list[tuple], int]:
         )
         systems.append((fs.ps, groups, centre))
     return sets, systems, len(pruned)
+
+
+def _search_sample(fw) -> dict:
+    """The real route's search of `fw` on one process for at most REAL_SAMPLE_SECONDS: its
+    seconds, boxes, the share of the poses it decided, and whether it finished."""
+    from ..backends.boxes import MIN_WIDTH, SHORT, search
+    from ..backends.real_route import landscape
+
+    found = search(landscape(fw), SHORT, MIN_WIDTH, max_seconds=REAL_SAMPLE_SECONDS,
+                   label=f"sample search of {fw.name}")  # fmt: skip
+    return {"seconds": found.seconds, "boxes": found.boxes, "done": not found.budget_hit,
+            "decided": 1.0 - found.undecided_share}  # fmt: skip
+
+
+def _paced(probe: dict | None) -> str:
+    """What the sample search says of the whole search's time (nothing where not run)."""
+    from ..progress import duration
+
+    if probe is None:
+        return ""
+    if probe["done"]:
+        return (f"; a whole search took {duration(probe['seconds'])} on one process "
+                f"({probe['boxes']:,} boxes)")  # fmt: skip
+    said = (f"; a {duration(probe['seconds'])} sample search decided {probe['decided']:.2%} of "
+            f"the poses ({probe['boxes']:,} boxes)")  # fmt: skip
+    if probe["decided"] <= 0:
+        return said + ": the whole search is far beyond the sample"
+    return said + (f": at least about {duration(probe['seconds'] / probe['decided'])} on one "
+                   "process, likely more (the first boxes decide the most)")  # fmt: skip
 
 
 def announce(fw, settings: Settings) -> Cost | None:

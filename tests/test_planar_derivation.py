@@ -165,9 +165,21 @@ def test_shipped_tori_are_derived_as_sympy_derives_them(name):
         _agree(fw, taut)
 
 
-def test_fourbar_and_spatial_frameworks_keep_the_sympy_derivation():
-    for name in ("fourbar", "prism"):
-        assert not planar_torus(cb.Framework.from_toml(ROOT / "examples" / f"{name}.toml"))
+@pytest.mark.parametrize("path", ["examples/fourbar.toml", "tests/fixtures/fivebar.toml",
+                                  "tests/fixtures/fourbar_springs.toml"])  # fmt: skip
+def test_closed_loops_are_derived_as_sympy_derives_them(path):
+    """Bodies pinned in a tree with a pin closing the loop: the multipliers, the pins'
+    equations, the Lagrangian's Hessian and the constraints' functions, every taut set."""
+    fw = cb.Framework.from_toml(ROOT / path)
+    assert planar_torus(fw)
+    cables = tuple(c.name for c in fw.cables)
+    for r in range(len(cables) + 1):
+        for taut in itertools.combinations(cables, r):
+            _agree(fw, taut)
+
+
+def test_spatial_frameworks_keep_the_sympy_derivation():
+    assert not planar_torus(cb.Framework.from_toml(ROOT / "examples" / "prism.toml"))
 
 
 def test_a_first_real_solve_imports_no_sympy(tmp_path):

@@ -77,8 +77,10 @@ class Poly:
 
 
 def planar_torus(fw: Framework) -> bool:
-    """Whether `derive_planar` covers the framework: planar, only rotations, no bar."""
-    return fw.dim == 2 and layout(fw).is_torus and not fw.bars
+    """Whether `derive_planar` covers the framework: planar, only rotations (bodies pinned to
+    the ground in a tree, loop-closing pins allowed), no bar."""
+    lay = layout(fw)
+    return fw.dim == 2 and not (lay.translations or lay.free_nodes or fw.bars)
 
 
 class _Algebra:
@@ -153,6 +155,9 @@ def _unknowns(fw: Framework, taut: tuple[str, ...]) -> tuple[list[str], list[str
         if x.name not in zfl:
             variables += [f"d_{x.name}", f"w_{x.name}"]
             kinds += ["len", "k"]
+    for k in layout(fw).closing_pins:  # a closing pin's multipliers (derive._constraints)
+        variables += [f"mu_pin{k + 1}_{a}" for a in "xy"]
+        kinds += ["force", "force"]
     return variables, kinds
 
 
@@ -174,12 +179,32 @@ def _equations(alg: _Algebra, taut: tuple[str, ...]) -> tuple[list[Poly], list[s
     for load in fw.loads:
         f = [alg.symbol(f"f_{load.name}_{a}") for a in "xy"]
         E = E - _dot(f, alg.of(load.point))
+    for k, gap in _closing_gaps(alg):  # E + mu . gap, and gap = 0
+        for a, g in zip("xy", gap, strict=True):
+            E = E + alg.symbol(f"mu_pin{k + 1}_{a}") * g
+            laws.append(g)
+            about.append(f"pin {k + 1}: {a}")
     eqs, names = [], []
     for b in alg.lay.rotations:
         c, s = alg.symbol(f"c_{b}"), alg.symbol(f"s_{b}")
         eqs += [alg.turn(b, E), c * c + s * s - alg.number(1)]
         names += [f"body {b}: moment", f"body {b}: unit rotation"]
     return eqs + laws, names + about
+
+
+def _closing_gaps(alg: _Algebra) -> list[tuple[int, list[Poly]]]:
+    """(k, a - b) of each loop-closing pin k (derive._constraints)."""
+    return [(k, [p - q for p, q in zip(alg.of(a), alg.of(b), strict=True)])
+            for k in alg.lay.closing_pins for a, b in [alg.fw.pins[k]]]  # fmt: skip
+
+
+def _constraint_code(alg: _Algebra) -> tuple[tuple, tuple]:
+    """(code, outputs) of constraint_jacobian (each closing pin coordinate's derivative along
+    each body's angle) and of constraint_values (the pins' gaps)."""
+    jac, val = _Code(), _Code()
+    gaps = [g for _, gap in _closing_gaps(alg) for g in gap]
+    firsts = [jac.name(alg.turn(b, g)) for g in gaps for b in alg.lay.rotations]
+    return (jac, firsts), (val, [val.name(g) for g in gaps])
 
 
 def _parametric(alg: _Algebra, variables: list[str], names: tuple[str, ...],
@@ -303,6 +328,11 @@ def _hessian(alg: _Algebra, taut: tuple[str, ...]) -> tuple[_Code, list[str]]:
             work = -_dot(f, [alg.turn(bodies[i], alg.turn(bodies[j], p))
                              for p in alg.of(ld.point)])  # fmt: skip
             H[i, j] += [code.name(work)] if work.terms else []
+    for k, gap in _closing_gaps(alg):  # the Lagrangian's: mu . gap_ij
+        mu = [alg.symbol(f"mu_pin{k + 1}_{a}") for a in "xy"]
+        for i, j in upper:
+            work = _dot(mu, [alg.turn(bodies[i], alg.turn(bodies[j], g)) for g in gap])
+            H[i, j] += [code.name(work)] if work.terms else []
     names = {ij: code.let(" + ".join(t)) if t else None for ij, t in H.items()}
     return code, [names[min(i, j), max(i, j)] for i in range(n) for j in range(n)]
 
@@ -371,13 +401,15 @@ def derive_planar(fw: Framework, taut: tuple[str, ...]) -> Derived:
     coords = [p for q in points[: -len(lay.rotations) or None] for p in alg.of(q)]
     coords += [p for b in lay.rotations for p in alg.translation(b)]
     at = _Code()
+    jacobian, values = _constraint_code(alg)
     source = "\n".join([
         "from numpy import sqrt, sin, cos\n",
         _function("positions", variables, slots, at, [at.expr(p) for p in coords]),
         _function("hessian", variables, slots, *_hessian(alg, taut)),
-        _function("constraint_jacobian", variables, slots, _Code(), []),
+        _function("constraint_jacobian", variables, slots, *jacobian),
         _function("first_order", variables, slots, *_first_order(alg, taut)),
-        _function("constraint_values", variables, slots, _Code(), []),
+        _function("constraint_values", variables, slots, *values),
     ])  # fmt: skip
-    return Derived(ps.to_json(), kinds, descriptions, free, points, len(lay.rotations), 0,
-                   source, [x.name for x in active_links(fw, taut)], _cones(alg, taut))  # fmt: skip
+    return Derived(ps.to_json(), kinds, descriptions, free, points, len(lay.rotations),
+                   2 * len(lay.closing_pins), source, [x.name for x in active_links(fw, taut)],
+                   _cones(alg, taut))  # fmt: skip

@@ -132,7 +132,8 @@ def add_route(p: argparse.ArgumentParser) -> None:
         choices=("real", "complex"),
         help="how a framework is solved: real (branch and bound over its configuration space, "
         "real equilibria only, proved complete; circles and tori of planar bodies' angles, "
-        "products of spheres of nodes hung on bars) or complex (every complex root of "
+        "four-bars, products of spheres of nodes hung on bars, nodes held by springs and "
+        "cables alone) or complex (every complex root of "
         "every taut set); default: real where it covers the configuration space; the paper's "
         "cases: Bertini, or the real route's search with --route real",
     )

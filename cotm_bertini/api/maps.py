@@ -206,6 +206,7 @@ def grid_route(model, grid: str, settings: Settings) -> str:
     if grid not in GRIDS:
         raise ParameterError(f"grid = {grid!r}: not a grid route ({', '.join(GRIDS)})")
     real = not isinstance(model, Params) and framework_route(model, settings) == "real"
+    real = real and _followed(model)
     if grid == "continuation" and not real:
         raise ParameterError("grid = 'continuation': only for a framework on the real route "
                              "(a torus of body angles or a product of spheres)")  # fmt: skip
@@ -220,6 +221,15 @@ def grid_route(model, grid: str, settings: Settings) -> str:
     if grid == "auto":
         return "continuation" if real and covers(model) == "" and model.dim == 3 else "search"
     return grid
+
+
+def _followed(model) -> bool:
+    """Whether continuation in chart angles follows the framework's equilibria: a torus of body
+    angles or a product of spheres (not yet a loop's curve nor free nodes' coordinates)."""
+    from ..backends.free_nodes import free_nodes_only
+    from ..model.framework.structure import layout
+
+    return not layout(model).closing_pins and bool(free_nodes_only(model))
 
 
 def _chart_design_map(model, xa: tuple, ya: tuple, settings, workers: int, key: str):

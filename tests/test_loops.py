@@ -127,3 +127,26 @@ def test_a_triple_rocker_on_both_routes_agrees(tmp_path):
     a, b = real.physical.sort_values(cols[0]), cplx.physical.sort_values(cols[0])
     np.testing.assert_allclose(a[cols].to_numpy(float), b[cols].to_numpy(float), atol=1e-8)
     assert list(a["kind"]) == list(b["kind"]) and len(a) == 4
+
+
+def test_a_change_point_four_bar_says_what_it_could_not_prove(tmp_path):
+    """A four-bar at Grashof's change point (s + l = p + q: it folds flat, and its curve of
+    poses crosses itself there, J of rank 1): the search cannot prove the box at the flat pose,
+    which is reported as a degenerate row, with the status incomplete and the boxes left said;
+    the smooth equilibria are still the statics' (both branches meet at the flat pose)."""
+    fb = FourBar((0.0, 0.0), (2.5, 0.0), 1.0, 2.0, 1.5, (0.6, 0.4), 0.8, (
+        ("s0", "spring", "crank", (-0.5, 1.0), 1.5, 0.4),
+        ("s1", "spring", "coupler", (1.2, 2.5), 1.0, 0.6),
+        ("c2", "cable", "rocker", (3.0, -1.0), 2.0, 0.7),
+    ))  # fmt: skip
+    path = tmp_path / "change_point.toml"
+    path.write_text(fb.toml("change_point"))
+    res = cb.solve(cb.Framework.from_toml(path), cache=False)
+    assert res.status == "incomplete"
+    assert any("undecided" in w for w in res.warnings)
+    flat = res.physical[res.physical["kind"] == "degenerate"]
+    assert len(flat) == 1 and abs(flat["crank.angle_deg"].iloc[0] % 360 - 180) < 1e-4
+    smooth = res.physical[res.physical["kind"] != "degenerate"]
+    for _, row in smooth.iterrows():
+        b = fb.branch_of(row["crank.angle_deg"], row["coupler.angle_deg"])
+        assert abs(_slope(fb, np.radians(row["crank.angle_deg"]), b)) < 1e-7

@@ -21,6 +21,13 @@ SPRUNG = FourBar((0.0, 0.0), (2.0, 0.0), 0.8, 2.0, 1.6, (1.0, 0.6), 1.0, (
     ("coupler_spring", "spring", "coupler", (1.2, 2.5), 1.0, 0.6),
     ("rocker_cable", "cable", "rocker", (3.0, -1.0), 2.0, 0.7),
 ))  # fmt: skip
+# A crank spring, a coupler spring and a rocker cable (the triple rocker's and the change
+# point's).
+LINKS = (
+    ("s0", "spring", "crank", (-0.5, 1.0), 1.5, 0.4),
+    ("s1", "spring", "coupler", (1.2, 2.5), 1.0, 0.6),
+    ("c2", "cable", "rocker", (3.0, -1.0), 2.0, 0.7),
+)
 
 
 def _slope(fb: FourBar, theta: float, branch: int, h: float = 1e-6) -> float:
@@ -113,11 +120,7 @@ def test_a_triple_rocker_on_both_routes_agrees(tmp_path):
     """A non-Grashof four-bar (no link turns fully: its poses are one circle through both
     assembly branches, which meet where the crank turns back): the real route's rows and kinds
     are the complex route's (whose first solve tracks 4,096 paths, some 3 minutes)."""
-    fb = FourBar((0.0, 0.0), (2.6, 0.0), 1.2, 1.3, 1.4, (0.6, 0.4), 0.8, (
-        ("s0", "spring", "crank", (-0.5, 1.0), 1.5, 0.4),
-        ("s1", "spring", "coupler", (1.2, 2.5), 1.0, 0.6),
-        ("c2", "cable", "rocker", (3.0, -1.0), 2.0, 0.7),
-    ))  # fmt: skip
+    fb = FourBar((0.0, 0.0), (2.6, 0.0), 1.2, 1.3, 1.4, (0.6, 0.4), 0.8, LINKS)
     path = tmp_path / "triple_rocker.toml"
     path.write_text(fb.toml("triple_rocker"))
     fw = cb.Framework.from_toml(path)
@@ -134,11 +137,7 @@ def test_a_change_point_four_bar_says_what_it_could_not_prove(tmp_path):
     poses crosses itself there, J of rank 1): the search cannot prove the box at the flat pose,
     which is reported as a degenerate row, with the status incomplete and the boxes left said;
     the smooth equilibria are still the statics' (both branches meet at the flat pose)."""
-    fb = FourBar((0.0, 0.0), (2.5, 0.0), 1.0, 2.0, 1.5, (0.6, 0.4), 0.8, (
-        ("s0", "spring", "crank", (-0.5, 1.0), 1.5, 0.4),
-        ("s1", "spring", "coupler", (1.2, 2.5), 1.0, 0.6),
-        ("c2", "cable", "rocker", (3.0, -1.0), 2.0, 0.7),
-    ))  # fmt: skip
+    fb = FourBar((0.0, 0.0), (2.5, 0.0), 1.0, 2.0, 1.5, (0.6, 0.4), 0.8, LINKS)
     path = tmp_path / "change_point.toml"
     path.write_text(fb.toml("change_point"))
     res = cb.solve(cb.Framework.from_toml(path), cache=False)

@@ -106,9 +106,7 @@ class ClosingPin:
     def numeric(self, X, P, g: np.ndarray, H: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """F and its Jacobian at points (R, 3), V's gradient and Hessian there given."""
         h, J = self.parts(self.fs.numeric, X, P)
-        count = len(g)
-        h = [np.broadcast_to(np.asarray(v, dtype=float), (count,)) for v in h]
-        J = [[np.broadcast_to(np.asarray(v, dtype=float), (count,)) for v in row] for row in J]
+        h, J = _arrays(h, len(g)), [_arrays(row, len(g)) for row in J]
         gl = [g[:, i] for i in range(3)]
         F = np.stack(self.system(h, J, gl), axis=1)
         rows = self.jacobian_rows(J, gl, [[H[:, i, k] for k in range(3)] for i in range(3)])
@@ -117,13 +115,16 @@ class ClosingPin:
     def pin_multipliers(self, X, P, g: np.ndarray) -> np.ndarray:
         """mu (R, 2) with g + J^T mu = 0 (least squares; exact at a critical point on M)."""
         _, J = self.parts(self.fs.numeric, X, P)
-        count = len(g)
-        A = np.stack([np.stack([np.broadcast_to(np.asarray(v, dtype=float), (count,))
-                                for v in row], axis=1) for row in J], axis=1)  # fmt: skip
+        A = np.stack([np.stack(_arrays(row, len(g)), axis=1) for row in J], axis=1)
         # (R, 2, 3): solve A^T mu = -g per point
         return np.stack(
             [np.linalg.lstsq(a.T, -b, rcond=None)[0] for a, b in zip(A, g, strict=True)]
         )
+
+
+def _arrays(values: list, count: int) -> list[np.ndarray]:
+    """Generated numeric outputs (arrays, or constants) as arrays of `count` points."""
+    return [np.broadcast_to(np.asarray(v, dtype=float), (count,)) for v in values]
 
 
 def _interval(v, count: int) -> Interval:

@@ -199,10 +199,10 @@ class TorusFramework:
         each free node's coordinates."""
         index = {v: j for j, v in enumerate(fs.ps.variables)}
         X: list = [0.0] * len(fs.ps.variables)
-        for v, coords in zip(self.nodes, trig if self.nodes else (), strict=True):
-            for a, value in zip("xyz", coords, strict=False):
-                X[index[f"n_{v}_{a}"]] = value
         if self.nodes:
+            for v, coords in zip(self.nodes, trig, strict=True):
+                for a, value in zip("xyz", coords, strict=False):
+                    X[index[f"n_{v}_{a}"]] = value
             return X
         for b, (s, c) in zip(self.bodies, trig, strict=True):
             X[index[f"s_{b}"]], X[index[f"c_{b}"]] = s, c

@@ -33,6 +33,7 @@ from ..model.framework.spec import Framework, units
 from ..model.framework.structure import layout
 from ..model.framework.units import normalized_slots
 from ..model.intervals import Interval, stack
+from . import rotations
 from .boxes import (
     MIN_WIDTH,
     SHORT,
@@ -67,9 +68,14 @@ from .links import (
     taut_groups,
 )
 from .loops import ClosingPin, single_loop
+from .rotations import turning_bodies
 from .spheres import SphereFramework
 
 ONLY = ("all", "stable")  # what a search looks for: every critical point, or the minima
+# Chart units: a turning body's boxes this narrow get the mean-value form too (examples/ball_joint
+# and a random body: 0.1 took 7.0 and 18.1 s, 0.3 7.2 and 19.3 s, 0.03 8.2 and 37.2 s, none
+# 7 and 80 s).
+CENTRED = 0.1
 
 
 def covers(fw: Framework) -> str:
@@ -81,7 +87,7 @@ def covers(fw: Framework) -> str:
     if not why or (lay.free_nodes and not (lay.rotations or lay.translations or fw.bars)):
         return why  # nodes alone: covered, or why not
     if fw.dim == 3:
-        return sphere_chain(fw)[1]
+        return turning_bodies(fw) if lay.rotations else sphere_chain(fw)[1]
     if not lay.is_torus:
         return single_loop(fw)
     return ""
@@ -104,7 +110,7 @@ def landscape(fw: Framework, only: str = "all") -> TorusFramework | SphereFramew
 def new_landscape(fw: Framework) -> TorusFramework | SphereFramework:
     """The landscape of `fw`, built now (uncached: continuation in chart angles builds one for
     each parameter value it visits, continuation/charts.py)."""
-    spheres = fw.dim == 3 and bool(free_nodes_only(fw))
+    spheres = fw.dim == 3 and not layout(fw).rotations and bool(free_nodes_only(fw))
     return SphereFramework(fw) if spheres else TorusFramework(fw)
 
 
@@ -141,13 +147,16 @@ class TorusFramework:
         self.n = self.full.local_size
         self.bodies = layout(fw).rotations
         self.nodes = () if self.bodies else layout(fw).free_nodes  # coordinates, not angles
+        self.spatial = fw.dim == 3 and bool(self.bodies)  # chart coordinates: backends.rotations
         self.renumber()
         self.free_springs = [i for i, x in enumerate(self.links) if x.L0 is not None
                              and not x.cable]  # fmt: skip
         # backends.cones decides boxes through springs' cones (a spring's end moves in the
         # plane as the angles turn: two or more of them)
         self.loop = ClosingPin(self.full) if layout(fw).closing_pins else None
-        self.cone_sets = self.n >= fw.dim and self.loop is None  # (cones: of grad V, not F)
+        # (cones: of grad V, not F; a spatial body's cones are not enclosed: such boxes are
+        # left undecided, said as such)
+        self.cone_sets = self.n >= fw.dim and self.loop is None and not self.spatial
         self.member: np.ndarray | None = None  # a family's view: each box's member (rows)
         self.family: TorusFamily | None = None
 
@@ -199,6 +208,11 @@ class TorusFramework:
         each free node's coordinates."""
         index = {v: j for j, v in enumerate(fs.ps.variables)}
         X: list = [0.0] * len(fs.ps.variables)
+        if self.spatial:
+            for b, q in zip(self.bodies, trig, strict=True):
+                for a, value in zip("wxyz", q, strict=True):
+                    X[index[f"q{a}_{b}"]] = value
+            return X
         if self.nodes:
             for v, coords in zip(self.nodes, trig, strict=True):
                 for a, value in zip("xyz", coords, strict=False):
@@ -209,7 +223,10 @@ class TorusFramework:
         return X
 
     def trig(self, box: Interval) -> list:
-        """(sin, cos) of each body's angle over the boxes (a free node's coordinates)."""
+        """(sin, cos) of each body's angle over the boxes (a free node's coordinates; a spatial
+        body's quaternion)."""
+        if self.spatial:
+            return [tuple(rotations.quaternion(f)) for f in self.frames(box)]
         if self.nodes:
             d = self.fw.dim
             return [tuple(box[:, i * d + a] for a in range(d)) for i in range(len(self.nodes))]
@@ -218,6 +235,8 @@ class TorusFramework:
     def domain(self, start: int) -> tuple[np.ndarray, np.ndarray]:
         """The boxes a search starts from: the torus grid, or for free nodes the cube about
         the centre that holds every equilibrium, at most start^2 boxes a node."""
+        if self.spatial:  # the four chart cubes, halved once for a single body
+            return rotations.domain(len(self.bodies), 2 if len(self.bodies) == 1 else 1)
         if not self.nodes:
             return initial_boxes(self.n, start)
         per = max(1, int(round((start ** (2 * len(self.nodes))) ** (1 / self.n))))
@@ -247,6 +266,8 @@ class TorusFramework:
         """(squared lengths of the free-length springs, grad V, the cables' states) per box; a
         loop's F in place of grad V (backends.loops)."""
         lengths, grad, states = self.enclose_v(box)
+        if self.spatial:
+            grad = self._centred(box, self.to_chart(self.frames(box), grad)[0], states)
         if self.loop is not None:
             X = self.pose(self.full, self.trig(box))
             grad = self.loop.enclose(ball_module(self.full), X, self.P, grad)
@@ -272,6 +293,26 @@ class TorusFramework:
         lengths = stack([dds[i] for i in self.free_springs], axis=1) if self.free_springs else (
             Interval(np.zeros(shape + (0,))))  # fmt: skip
         return lengths, stack(grad, axis=1), states
+
+    def _centred(self, box: Interval, grad: Interval, states: dict) -> Interval:
+        """grad V in chart coordinates met with its mean-value form g(mid) + H(box) (box - mid)
+        on the boxes no wider than CENTRED where it may vanish: the generated code's natural
+        enclosure of a turning body's gradient is some 15 w wide on a box of width w, about
+        five times the mean-value form's."""
+        rows = np.flatnonzero(grad.contains_zero().all(axis=1)
+                              & ((box.hi - box.lo).max(axis=1) <= CENTRED))  # fmt: skip
+        if not len(rows):
+            return grad
+        sub, mid, land = box[rows], box.mid[rows], self.sub(rows)  # (a family's: its members')
+        _, at, _ = land.enclose_v(Interval(mid))
+        at = land.to_chart(land.frames(Interval(mid)), at)[0]
+        H = land.hessian(sub, {c: v[rows] for c, v in states.items()})
+        dev = sub - mid
+        mv = stack([interval_sum([at[:, i]] + [H[:, i, j] * dev[:, j] for j in range(self.n)])
+                    for i in range(self.n)], axis=1)  # fmt: skip
+        lo, hi = grad.lo.copy(), grad.hi.copy()
+        lo[rows], hi[rows] = np.maximum(lo[rows], mv.lo), np.minimum(hi[rows], mv.hi)
+        return Interval(lo, hi)
 
     def cone_parts(self, box: Interval, spring: np.ndarray) -> ConeParts:
         """What backends.cones needs of each box about its spring `spring` (an index into the
@@ -315,6 +356,8 @@ class TorusFramework:
         """The hull of the Hessians of every taut set each box allows (B, n, n); a loop's
         Jacobian of F (backends.loops)."""
         hess = self.hessian_v(box, states)
+        if self.spatial:
+            return self.to_chart(self.frames(box), self.enclose_v(box)[1], hess)[1]
         if self.loop is None:
             return hess
         X = self.pose(self.full, self.trig(box))
@@ -346,6 +389,8 @@ class TorusFramework:
         generated numpy code (Newton's steps; each point's Hessian that of its taut set); a
         loop's F and its Jacobian."""
         grad, hess = self.derivatives_v(x)
+        if self.spatial:
+            return self.to_chart(self.frames(x), grad, hess)
         if self.loop is None:
             return grad, hess
         X = self._numeric_pose(self.full, x)
@@ -397,6 +442,11 @@ class TorusFramework:
     def _numeric_pose(self, fs: FrameworkSystem, x: np.ndarray) -> np.ndarray:
         index = {v: j for j, v in enumerate(fs.ps.variables)}
         X = np.zeros((len(x), len(fs.ps.variables)))
+        if self.spatial:
+            for b, q in zip(self.bodies, self.trig(x), strict=True):
+                for a, value in zip("wxyz", q, strict=True):
+                    X[:, index[f"q{a}_{b}"]] = value
+            return X
         for i, v in enumerate(self.nodes):
             for a in range(self.fw.dim):
                 X[:, index[f"n_{v}_{'xyz'[a]}"]] = x[:, i * self.fw.dim + a]
@@ -407,11 +457,46 @@ class TorusFramework:
     def fresh(self, points: np.ndarray, known: np.ndarray) -> np.ndarray:
         """The points that are neither at a `known` one nor at an earlier one (fresh_points;
         free nodes' coordinates do not wrap)."""
+        if self.spatial:
+            return _fresh_rotations(self.quaternions(points), self.quaternions(known), points)
         return fresh_points(points, known, wrap=not self.nodes)
+
+    def rechart(self, x: np.ndarray) -> np.ndarray:
+        """Points (R, n) with each spatial body in the chart where it is most regular (others
+        as they are)."""
+        if not self.spatial:
+            return x
+        q = self.quaternions(x)
+        return np.hstack([rotations.chart_points(q[:, j]) for j in range(len(self.bodies))])
+
+    def frames(self, x) -> list[dict]:
+        """Each spatial body's chart frame (backends.rotations.frame) over boxes or at points."""
+        return [rotations.frame(x[:, 3 * j : 3 * j + 3]) for j in range(len(self.bodies))]
+
+    def quaternions(self, x: np.ndarray) -> np.ndarray:
+        """Each spatial body's unit quaternion at points (R, bodies, 4)."""
+        qs = [rotations.quaternion(f) for f in self.frames(x.reshape(-1, self.n))]
+        return np.stack([np.stack(q, axis=1) for q in qs], axis=1).reshape(len(x), len(qs), 4)
+
+    def to_chart(self, frames: list, grad, hess=None) -> tuple:
+        """(grad V, its Hessian or None) from the generated code's local coordinates to the
+        bodies' chart coordinates (backends.rotations): an Interval (B, n) and (B, n, n) over
+        boxes, or arrays at points."""
+        Ds = [rotations.jacobian(f) for f in frames]
+        g = [grad[:, i] for i in range(self.n)]
+        out = [c for j, (f, D) in enumerate(zip(frames, Ds, strict=True))
+               for c in rotations.gradient(f, D, g[3 * j : 3 * j + 3])]  # fmt: skip
+        if hess is not None:
+            hess = _chart_hessian(frames, Ds, g, hess)
+        return (stack(out, axis=1) if isinstance(grad, Interval) else np.stack(out, axis=1)), hess
 
     def chart_points(self, cols: dict) -> np.ndarray:
         """The chart points (R, n body angles, or free nodes' coordinates in normalised units)
-        of a solutions table's rows (`cols`: columns)."""
+        of a solutions table's rows (`cols`: columns; a spatial body's chart coordinates)."""
+        if self.spatial:
+            return np.hstack([rotations.chart_points(np.stack(
+                [np.asarray(cols[f"{b}.q{a}"], dtype=float) for a in "wxyz"], axis=1))
+                for b in self.bodies])  # fmt: skip
         if self.nodes:
             scale = units(self.fw)[0]
             return np.stack(
@@ -426,7 +511,10 @@ class TorusFramework:
         return np.radians(np.stack(angles, axis=1)).reshape(-1, self.n)
 
     def endpoints(self, roots: np.ndarray) -> dict[tuple[str, ...], Endpoints]:
-        """The critical points (R, n angles) as endpoints of their taut sets' systems."""
+        """The critical points (R, n angles) as endpoints of their taut sets' systems (a
+        spatial body's rotation found in two charts' overlap once)."""
+        if self.spatial:
+            roots = self.fresh(roots, np.zeros((0, self.n)))
         d = self._lengths(roots)
         out = {}
         for names, rows in taut_groups(self.cables, self.links, d, len(roots)):
@@ -451,9 +539,12 @@ class TorusFramework:
     def _endpoints(self, fs: FrameworkSystem, angles: np.ndarray, d: dict, rows) -> Endpoints:
         links = {x.name: x for x in self.links}
         values = np.zeros((len(rows), len(fs.ps.variables)), dtype=complex)
+        q = self.quaternions(angles) if self.spatial else None
         for k, v in enumerate(fs.ps.variables):
             head, _, rest = v.partition("_")
-            if head == "n":
+            if q is not None and head in ("qw", "qx", "qy", "qz"):
+                values[:, k] = q[:, self.bodies.index(rest), "wxyz".index(head[1])]
+            elif head == "n":
                 node, _, axis = rest.rpartition("_")
                 values[:, k] = angles[:, self.nodes.index(node) * self.fw.dim + "xyz".index(axis)]
             elif head in ("c", "s"):
@@ -638,6 +729,42 @@ def descent_minima(land, starts: int, seed: int, steps: int = 200) -> np.ndarray
     g, h = land.derivatives(x)
     good = (np.abs(g).max(axis=1) < 1e-10) & (np.linalg.eigvalsh(h) > 0).all(axis=1)
     return x[good]
+
+
+def _chart_hessian(frames: list, Ds: list, g: list, hess) -> Interval | np.ndarray:
+    """Hess_u V = D Hess_v V D^T + sum_a g_a W_a (backends.rotations; D block diagonal, a block
+    per body), from Hess_v V (`hess`: (B, n, n) Interval or (R, n, n) array) and grad_v V's
+    columns `g`."""
+    n, boxes = len(g), isinstance(hess, Interval)
+    add = interval_sum if boxes else sum
+    rows: list[list] = [[None] * n for _ in range(n)]
+    for j, Dj in enumerate(Ds):
+        for k, Dk in enumerate(Ds):
+            # (D_j H_jk) first, then times D_k^T: 54 products a block in place of 81
+            left = [[add(Dj[p][a] * hess[:, 3 * j + a, 3 * k + b] for a in range(3))
+                     for b in range(3)] for p in range(3)]  # fmt: skip
+            for p in range(3):
+                for r in range(3):
+                    rows[3 * j + p][3 * k + r] = add(left[p][b] * Dk[r][b] for b in range(3))
+        bend = rotations.curvature(frames[j], Dj, g[3 * j : 3 * j + 3])
+        for p in range(3):
+            for r in range(3):
+                rows[3 * j + p][3 * j + r] = rows[3 * j + p][3 * j + r] + bend[p][r]
+    if not boxes:
+        return np.stack([np.stack(row, axis=1) for row in rows], axis=1)
+    return stack([stack(row, axis=1) for row in rows], axis=1)
+
+
+def _fresh_rotations(q: np.ndarray, known: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """The `points` whose bodies' quaternions `q` (R, bodies, 4) are neither a `known` pose's
+    (up to each body's sign) nor an earlier point's."""
+    seen = list(known)
+    kept = []
+    for x, p in zip(points, q, strict=True):
+        if not any(rotations.same(p, s) for s in seen):
+            kept.append(x)
+            seen.append(p)
+    return np.array(kept).reshape(-1, points.shape[1] if points.ndim == 2 else 0)
 
 
 def fresh_points(points: np.ndarray, known: np.ndarray, apart: float = 1e-8,

@@ -18,7 +18,7 @@ import numpy as np
 
 from .analysis.classify import classify_columns
 from .analysis.morse import morse_check
-from .backends.boxes import MIN_WIDTH
+from .boxsearch.boxes import MIN_WIDTH
 from .backends.crossings import in_solve
 from .backends.endpoints import Endpoints
 from .errors import ParameterError
@@ -325,9 +325,9 @@ def solve_framework_points(
 ) -> list[PointSolution]:
     """solve_framework_point at each of several values of one framework (a sweep's points).
     On the real route their searches run together, in the same batches of boxes
-    (backends.real_route.search_frameworks): each point keeps its own search, box for box
+    (boxsearch.real_route.search_frameworks): each point keeps its own search, box for box
     the one it would have alone; every point is checked before any is searched."""
-    from .backends.real_route import search_frameworks
+    from .boxsearch.real_route import search_frameworks
 
     if not fws or framework_route(fws[0], settings) != "real":
         return [solve_framework_point(fw, settings, tolerances) for fw in fws]
@@ -414,7 +414,7 @@ PAPER_REAL_REFUSED = (
 def framework_route(fw, settings: Settings) -> str:
     """'real' or 'complex': the route asked for, or by default the real one wherever it covers
     the configuration space (a refusal names why it cannot where 'real' was asked for)."""
-    from .backends.real_route import covers
+    from .boxsearch.real_route import covers
 
     why = covers(fw)
     if settings.route == "real" and why:
@@ -431,7 +431,7 @@ DESCENTS = 64  # local descents from random poses when a search is stopped by it
 def _real_landscape(fw, t: Timings, only: str = "all") -> tuple:
     """(the real route's landscape of `fw` searching for `only`, its taut sets, those pruned),
     every taut set's equations derived and checked."""
-    from .backends.real_route import landscape
+    from .boxsearch.real_route import landscape
     from .model.framework.compiled import check_terms
     from .model.framework.units import normalized_slots
 
@@ -449,16 +449,16 @@ def _solve_real(
     fw, settings: Settings, tolerances: Tolerances, t: Timings, ready=None, found=None
 ) -> PointSolution:
     """Every real equilibrium of a framework on a circle, torus or product of spheres, by the
-    branch and bound of backends.boxes over its configuration space, classified as the complex
+    branch and bound of boxsearch.boxes over its configuration space, classified as the complex
     route's endpoints are; the search's proof (or what it left undecided) is the completeness
     check. Boxes left undecided are searched for continua of equilibria, traced and counted
     apart as on the complex route; regions where a node floats are reported apart. `ready` and
     `found`: the landscape (_real_landscape) and its search, where already made."""
     from .analysis.framework_checks import completeness, framework_counts, order_rows
     from .analysis.framework_continua import absorb, continuum_record, find_continua
-    from .backends.box_shares import deepened, split_search
-    from .backends.boxes import SHORT
-    from .backends.real_route import landscape
+    from .boxsearch.box_shares import deepened, split_search
+    from .boxsearch.boxes import SHORT
+    from .boxsearch.real_route import landscape
     from .model.framework.units import units
 
     unit = units(fw)
@@ -499,7 +499,7 @@ def _solve_real(
         failure = stability.pop("failure")
     status, warnings = _real_status(found, search_info, checks, failure)
     counts = {**framework_counts(table, report, continua), "boxes": found.boxes}
-    engine = {"flavour": "real", "path": "branch and bound (backends.boxes)", "version": ""}
+    engine = {"flavour": "real", "path": "branch and bound (boxsearch.boxes)", "version": ""}
     shape = {"taut_sets": list(report), "units": {"length": unit[0], "stiffness": unit[1]}}
     return PointSolution(
         fw, settings, table, None, counts, checks["morse"],
@@ -541,11 +541,11 @@ def _real_status(found, search_info: dict, checks: dict, failure: str | None) ->
 
 def _minima_only(land, found, seeds: np.ndarray, descents: dict, seed: int | None) -> tuple:
     """(found, seeds, what was proved) of a search for the stable equilibria alone: its roots
-    proved minima or not (backends.minima; those proved not to be dropped, the undecided kept
+    proved minima or not (boxsearch.minima; those proved not to be dropped, the undecided kept
     with a warning), the seeds Newton found (not proved) kept where their Hessian is positive
     definite."""
-    from .backends.minima import proved_minima
-    from .backends.real_route import descent_minima
+    from .boxsearch.minima import proved_minima
+    from .boxsearch.real_route import descent_minima
 
     verdict = proved_minima(land, found.roots)
     keep = verdict >= 0
@@ -589,7 +589,7 @@ def _unproved(land, found, unit: tuple[float, float], seed: int | None) -> tuple
     left undecided (a continuum passes there) or set aside next to a cone point, found by
     Newton (not proved unique; a search stopped by its budget leaves much undecided: more
     seeds, more rows found) and by descents; the free regions, whose points are not rows."""
-    from .backends.real_route import critical_seeds
+    from .boxsearch.real_route import critical_seeds
 
     most = SEEDS_AT_BUDGET if found.budget_hit else 32
     seeds = land.fresh(np.vstack([critical_seeds(land, found.undecided, most),
@@ -605,7 +605,7 @@ def _descents(land, found, seeds, seed: int | None) -> dict:
     """Evidence for a search stopped by its budget (none otherwise): local descents from
     DESCENTS random poses, the minima they reach, and how many of those the search or Newton
     had already found (the others join the rows)."""
-    from .backends.real_route import descent_minima
+    from .boxsearch.real_route import descent_minima
 
     if not found.budget_hit:
         return {"starts": 0, "points": np.zeros((0, land.n))}
@@ -724,7 +724,7 @@ def real_search_info(found, length_unit: float, along: int = 0, morse_bott: bool
 
 def cone_records(land, found, unit: tuple[float, float]) -> list[dict]:
     """The search's proved cone points (poses where a spring has zero length and V a critical
-    point in Clarke's sense: backends.cones), each with its spring, the body angles (deg), the
+    point in Clarke's sense: boxsearch.cones), each with its spring, the body angles (deg), the
     other elements' pull there against the spring's k L0 (file units), and its index and kind
     (V falls across the cone set: a maximum in the plane of the spring's ends)."""
     n = land.n

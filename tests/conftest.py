@@ -88,7 +88,7 @@ def same_sets(a: np.ndarray, b: np.ndarray, tol: float = 1e-8) -> bool:
 def lose_first_root(monkeypatch) -> list:
     """Sabotage the real route: its search drops the first root it proves (returned in the
     list, once it has): the checks downstream must see the hole."""
-    from cotm_bertini.backends import boxes
+    from cotm_bertini.boxsearch import boxes
 
     real_roots, dropped = boxes._roots, []
 

@@ -7,13 +7,14 @@ from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parent.parent / "cotm_bertini"
 
-# Lower layers never import higher ones (data flows params -> model -> backends -> analysis ->
-# point -> continuation -> catastrophe/motion -> io/plot -> api -> paper -> cli).
+# Lower layers never import higher ones (data flows params -> model -> backends -> boxsearch ->
+# analysis -> point -> continuation -> catastrophe/motion -> io/plot -> api -> paper -> cli).
 LAYERS = [
     {"_version", "errors", "fs", "versions", "resources", "columns", "literals", "progress"},
     {"params", "settings"},
     {"model"},
     {"backends"},
+    {"boxsearch"},
     {"analysis"},
     {"point"},
     {"continuation"},

@@ -1,4 +1,4 @@
-"""The real route's branch and bound shared over worker processes (backends/box_shares.py):
+"""The real route's branch and bound shared over worker processes (boxsearch/box_shares.py):
 the same proof as in one process. chain3's rows, serial and on two local processes (and on a
 Dask cluster), against the independent reference of tests/test_chain3.py (V, grad V and its
 Hessian in plain numpy, Newton from a grid of starts); the shares' records merged box for box;
@@ -15,9 +15,9 @@ from test_chain3 import FILE, _angles, _pairing, critical_points, read_chain
 
 import cotm_bertini as cb
 from cotm_bertini import progress
-from cotm_bertini.backends import box_shares
-from cotm_bertini.backends.boxes import MIN_WIDTH, SHORT, domain, merged, search
-from cotm_bertini.backends.real_route import landscape
+from cotm_bertini.boxsearch import box_shares
+from cotm_bertini.boxsearch.boxes import MIN_WIDTH, SHORT, domain, merged, search
+from cotm_bertini.boxsearch.real_route import landscape
 
 SAME = 1e-8  # rad or table units: two runs of one proof agree to rounding
 

@@ -1,4 +1,4 @@
-"""Nodes held by springs and cables alone (backends/free_nodes.py): their equilibria on the real
+"""Nodes held by springs and cables alone (boxsearch/free_nodes.py): their equilibria on the real
 route, inside the proved bound, against a statics written here in numpy (no package code):
 Newton on grad V from many random poses within twice the bound, each critical point with its
 index; on random mechanisms nobody chose (anchors, stiffnesses, free lengths, loads anywhere;

@@ -1,4 +1,4 @@
-"""Closed loops on the real route (backends/loops.py): a four-bar's equilibria, against its
+"""Closed loops on the real route (boxsearch/loops.py): a four-bar's equilibria, against its
 statics in closed form (tests/fourbar_statics.py: both assembly branches by circle
 intersection, V along each as a function of the crank angle, its critical points by a dense
 scan bisected to 1e-13), on random Grashof crank-rockers nobody chose, and against the complex

@@ -1,5 +1,5 @@
 """`only="stable"`: the stable equilibria alone, each proved a strict local minimum, none
-missing (backends.stability drops the boxes where V can have no local minimum, backends.minima
+missing (boxsearch.stability drops the boxes where V can have no local minimum, boxsearch.minima
 proves the roots). Checked against the full search's stable rows, against minima found by an
 independent statics (Newton from many starts, a positive definite Hessian: tests'
 random_mechanisms and tensegrity_physics, no package code), and by sabotage."""
@@ -15,7 +15,7 @@ import tensegrity_physics as tp
 from conftest import ROOT
 
 import cotm_bertini as cb
-from cotm_bertini.backends import boxes
+from cotm_bertini.boxsearch import boxes
 from cotm_bertini.cli.main import main
 from cotm_bertini.errors import ParameterError
 

@@ -273,8 +273,8 @@ def test_searches_together_equal_each_search_alone():
     own search, box for box: at L0c = 1.3 (a free length of exactly 1 in the framework's
     units: a number per box kept exact, as one given alone is) and fy = 0 (a continuum of
     equilibria, boxes left undecided)."""
-    from cotm_bertini.backends.boxes import MIN_WIDTH, SHORT, search, search_each
-    from cotm_bertini.backends.real_route import TorusFamily, TorusFramework
+    from cotm_bertini.boxsearch.boxes import MIN_WIDTH, SHORT, search, search_each
+    from cotm_bertini.boxsearch.real_route import TorusFamily, TorusFramework
 
     fw = cb.Framework.from_toml(XMODULE)
     lands = [TorusFramework(fw.replace(L0c=a, fy=b))
@@ -387,8 +387,8 @@ def test_cone_points_proved_by_the_search_equal_bertinis(name):
     elements' pull there weaker than k L0) against Bertini's ab-initio solve of the zero-length
     system and the pull computed there: the same poses, each a maximum (index 2)."""
     from cotm_bertini.analysis.framework_checks import cone_points
-    from cotm_bertini.backends.boxes import MIN_WIDTH, SHORT, search
-    from cotm_bertini.backends.real_route import TorusFramework
+    from cotm_bertini.boxsearch.boxes import MIN_WIDTH, SHORT, search
+    from cotm_bertini.boxsearch.real_route import TorusFramework
 
     fw = cb.Framework.from_toml(ROOT / "examples" / f"{name}.toml")
     land = TorusFramework(fw)
@@ -509,8 +509,8 @@ def test_a_family_covered_together_proves_each_point_as_alone():
     over their hull (every number an interval holding each point's), then searches each point
     from what is left: each point's proved roots equal its own search's (4-link chain, 20
     values of a free length, a cable-free chain where one point would take 125k boxes)."""
-    from cotm_bertini.backends.boxes import MIN_WIDTH, SHORT, search
-    from cotm_bertini.backends.real_route import TorusFramework, search_frameworks
+    from cotm_bertini.boxsearch.boxes import MIN_WIDTH, SHORT, search
+    from cotm_bertini.boxsearch.real_route import TorusFramework, search_frameworks
 
     fw = cb.Framework.from_toml(ROOT / "tests" / "fixtures" / "chain4.toml")
     fws = [fw.replace(L0=v) for v in np.linspace(1.6, 2.0, 20)]

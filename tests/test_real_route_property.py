@@ -159,7 +159,7 @@ def test_the_spheres_slope_matrix_is_the_gradient_s_derivative_and_encloses_it()
     equals central differences of the point gradient (computed from the force densities, not
     from the Hessian's link blocks), and over random boxes the interval slope matrix holds the
     point Hessians of the box."""
-    from cotm_bertini.backends.real_route import new_landscape
+    from cotm_bertini.boxsearch.real_route import new_landscape
     from cotm_bertini.model.intervals import Interval
 
     land = new_landscape(cb.Framework.from_toml(ROOT / "tests" / "fixtures" / "prism_saddle.toml"))
@@ -184,7 +184,7 @@ def test_the_spheres_slope_matrix_is_the_gradient_s_derivative_and_encloses_it()
 
 
 def _chart_angles(sp, X: np.ndarray) -> np.ndarray:
-    """Each node's chart angles at a pose, written from the charts' definitions (backends.spheres:
+    """Each node's chart angles at a pose, written from the charts' definitions (boxsearch.spheres:
     chart A, u = (sin a cos b, sin a sin b, cos a); chart B, u = (cos a, sin a cos b,
     sin a sin b), its a stored 8 higher), chart B near the z axis: no package code."""
     out = []
@@ -202,9 +202,9 @@ def _chart_angles(sp, X: np.ndarray) -> np.ndarray:
 def test_the_spheres_enclosures_and_contraction_keep_every_newton_point(seed, nodes):
     """Random boxes of chart angles (0.001 to 1 rad, the point anywhere in them) around each
     critical point Newton finds on the independent statics: grad V's enclosure holds 0 and the
-    contracted box (backends.spheres: each node's pull along its bar) still holds the point."""
-    from cotm_bertini.backends.boxes import _contracted
-    from cotm_bertini.backends.real_route import new_landscape
+    contracted box (boxsearch.spheres: each node's pull along its bar) still holds the point."""
+    from cotm_bertini.boxsearch.boxes import _contracted
+    from cotm_bertini.boxsearch.real_route import new_landscape
     from cotm_bertini.model.intervals import Interval
 
     hn = rm.hanging_nodes(seed, nodes)
@@ -237,7 +237,7 @@ def test_a_contraction_that_cuts_a_root_out_is_caught(monkeypatch):
     """prism_saddle with the spheres' contraction sabotaged (a tenth of every box cut off one
     side, as a contraction that lost its rounding would): a root is lost, and the Morse count
     makes the solve a contradiction, not ok."""
-    from cotm_bertini.backends import spheres
+    from cotm_bertini.boxsearch import spheres
 
     real = spheres.SphereFramework.contract
 
@@ -278,11 +278,11 @@ def test_a_chain_whose_springs_collapse_is_proved_with_its_cone_points(seed, lin
 
 
 def test_the_cone_enclosures_hold_an_independent_statics(tmp_path):
-    """backends.cones reads A (grad V without the spring's -k L0 d), its slope matrix H, J and
+    """boxsearch.cones reads A (grad V without the spring's -k L0 d), its slope matrix H, J and
     d2r over boxes from the landscape: at random points of random boxes of a collapsing chain
     they hold A written here (the chain with that spring at zero free length), central
     differences of it and of the spring's vector (in the landscape's normalised units)."""
-    from cotm_bertini.backends.real_route import new_landscape
+    from cotm_bertini.boxsearch.real_route import new_landscape
     from cotm_bertini.model.framework.spec import units
     from cotm_bertini.model.intervals import Interval
 
@@ -320,7 +320,7 @@ def test_chain3_collapse_is_proved_with_its_cone_points_and_a_lost_one_is_a_cont
     index 2), the Morse count over rows and cone points 0. With the cone test sabotaged (a
     proved cone point dropped as if none were there) the Morse count fails and the solve says
     contradiction, not ok."""
-    from cotm_bertini.backends import boxes
+    from cotm_bertini.boxsearch import boxes
 
     fw = cb.Framework.from_toml(ROOT / "tests" / "fixtures" / "chain3_collapse.toml")
     res = cb.solve(fw, route="real", cache=False)
@@ -354,8 +354,8 @@ def test_a_moved_spheres_landscape_encloses_as_a_new_one_does():
     """Continuation moves a spheres landscape to other numbers (real_route.moved_landscape):
     its enclosures and contraction, which read constants off the generated code, must be those
     of a landscape built anew at the new numbers (a stale constant would shift every pull)."""
-    from cotm_bertini.backends.boxes import _contracted
-    from cotm_bertini.backends.real_route import moved_landscape, new_landscape
+    from cotm_bertini.boxsearch.boxes import _contracted
+    from cotm_bertini.boxsearch.real_route import moved_landscape, new_landscape
     from cotm_bertini.model.framework.units import normalized_slots
     from cotm_bertini.model.intervals import Interval
 
@@ -382,7 +382,7 @@ def test_a_moved_spheres_landscape_encloses_as_a_new_one_does():
 def test_a_table_s_rows_are_read_back_as_chart_points_at_their_poses(name):
     """landscape.chart_points (a sweep's fold is located from a table's rows): each row of a
     solve read back into chart angles is at the row's pose and is a critical point there."""
-    from cotm_bertini.backends.real_route import landscape
+    from cotm_bertini.boxsearch.real_route import landscape
     from cotm_bertini.model.framework.spec import units
 
     fw = cb.Framework.from_toml(ROOT / name)

@@ -1,4 +1,4 @@
-"""Rigid bodies turning in space on the real route (backends/rotations.py: SO(3) by four
+"""Rigid bodies turning in space on the real route (boxsearch/rotations.py: SO(3) by four
 quaternion charts), against a statics written in numpy in tests/so3_statics.py (no package code):
 Newton on SO(3) from thousands of random rotations, each critical point with its index; on
 random bodies nobody chose (body points, ground points, stiffnesses, free lengths, a cable, a

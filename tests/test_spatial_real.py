@@ -1,5 +1,5 @@
 """The real route on products of spheres (issue 41): spatial frameworks whose nodes hang by bars
-from the ground, solved by the branch and bound over chart angles (backends/spheres.py), checked
+from the ground, solved by the branch and bound over chart angles (boxsearch/spheres.py), checked
 against routes that share no code with it: the plain-numpy statics of tests/tensegrity_physics.py
 (Newton on the Lagrange conditions from thousands of poses, and the Morse sum on (S^2)^nodes),
 and the charts' cover of the sphere checked with the inverse charts written here."""
@@ -156,10 +156,10 @@ def _inverse_charts(u: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
 
 
 def _uncovered(u: np.ndarray) -> np.ndarray:
-    """The directions (unit rows) inside no chart box of backends.spheres.pieces with a
+    """The directions (unit rows) inside no chart box of boxsearch.spheres.pieces with a
     margin of 0.01 rad, by the inverse charts written here; where one is inside, the chart's
     direction at those angles is checked to be it."""
-    from cotm_bertini.backends.spheres import directions, pieces
+    from cotm_bertini.boxsearch.spheres import directions, pieces
 
     inside = np.zeros(len(u), dtype=bool)
     for (a, b), chart in zip(_inverse_charts(u), ("A", "B"), strict=True):
@@ -195,7 +195,7 @@ def test_the_chart_boxes_cover_the_sphere_with_room_to_spare():
 def test_charts_that_leave_a_gap_are_caught(monkeypatch):
     """Chart B's squares shrunk to less than the caps the band leaves out: directions near the
     poles are found uncovered (the cover test can fail)."""
-    from cotm_bertini.backends import spheres
+    from cotm_bertini.boxsearch import spheres
 
     monkeypatch.setattr(spheres, "CAP", spheres.BAND - 0.05)
     assert len(_uncovered(_directions()))

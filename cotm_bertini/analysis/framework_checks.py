@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..backends.crossings import in_solve
-from ..backends.free_nodes import free_nodes_only
-from ..backends.loops import single_loop
+from ..boxsearch.free_nodes import free_nodes_only
+from ..boxsearch.loops import single_loop
 from ..model.framework.compiled import FrameworkSystem, framework_system, slot_vector
 from ..model.framework.spec import Framework
 from ..model.framework.structure import layout
@@ -159,7 +159,7 @@ def configuration_space(fw: Framework) -> tuple[list[str], str]:
     held by springs and cables alone), else ([], why not)."""
     lay = layout(fw)
     if not free_nodes_only(fw):
-        # Nodes held by springs and cables alone: the product of balls backends.free_nodes
+        # Nodes held by springs and cables alone: the product of balls boxsearch.free_nodes
         # bounds them in, where the gradient points out at the boundary (chi 1).
         return ["R2" if fw.dim == 2 else "R3" for _ in lay.free_nodes], ""
     if lay.closing_pins and not lay.translations and not single_loop(fw):
@@ -271,7 +271,7 @@ def cone_points(fw: Framework, near: np.ndarray | None = None) -> list[dict]:
 def _cones_near(fw: Framework, ps, slots_n: dict, near: np.ndarray) -> np.ndarray:
     """The zero-length poses of one spring (system `ps`) that Newton reaches from the middles of
     the boxes `near` (lo1, lo2, hi1, hi2 rad), each once."""
-    from ..backends.real_route import coarse_pick
+    from ..boxsearch.real_route import coarse_pick
     from ..model.framework.structure import layout
     from .refine import newton_refine
 

@@ -322,8 +322,8 @@ def _sets(fw, settings: Settings) -> tuple[list[SetCost], list[tuple], int]:
 def _search_sample(fw) -> dict:
     """The real route's search of `fw` on one process for at most REAL_SAMPLE_SECONDS: its
     seconds, boxes, the share of the poses it decided, and whether it finished."""
-    from ..backends.boxes import MIN_WIDTH, SHORT, search
-    from ..backends.real_route import landscape
+    from ..boxsearch.boxes import MIN_WIDTH, SHORT, search
+    from ..boxsearch.real_route import landscape
 
     found = search(landscape(fw), SHORT, MIN_WIDTH, max_seconds=REAL_SAMPLE_SECONDS,
                    label=f"sample search of {fw.name}")  # fmt: skip

@@ -199,7 +199,7 @@ def grid_route(model, grid: str, settings: Settings) -> str:
     framework on the real route: anchors searched, equilibria followed in chart angles), "auto"
     (continuation for a product of spheres, whose fold systems sympy cannot expand; a search
     of every point where only the stable equilibria are asked for); or a one-line refusal."""
-    from ..backends.real_route import covers
+    from ..boxsearch.real_route import covers
     from ..errors import ParameterError
     from ..point import framework_route
 
@@ -226,7 +226,7 @@ def grid_route(model, grid: str, settings: Settings) -> str:
 def _followed(model) -> bool:
     """Whether continuation in chart angles follows the framework's equilibria: a torus of body
     angles or a product of spheres (not yet a loop's curve nor free nodes' coordinates)."""
-    from ..backends.free_nodes import free_nodes_only
+    from ..boxsearch.free_nodes import free_nodes_only
     from ..model.framework.structure import layout
 
     return not layout(model).closing_pins and bool(free_nodes_only(model))

@@ -1,7 +1,7 @@
 """Where picklable jobs run: in this process, on local worker processes, or on a Dask cluster
 (backends.dask_jobs). Sweeps send runs of grid points this way (continuation.runner), fold
 curves their lines (catastrophe.framework_folds), the real route its shares of boxes
-(backends.box_shares).
+(boxsearch.box_shares).
 """
 
 from __future__ import annotations

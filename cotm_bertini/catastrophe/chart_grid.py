@@ -1,7 +1,7 @@
 """The grid of a design map on the real route, by continuation in chart angles (no sweep of
 searches): what a map of a spatial framework can afford, where one proved search costs seconds.
 
-1. Anchors: the real route's search (backends.boxes) at ANCHORS x ANCHORS grid points (corners,
+1. Anchors: the real route's search (boxsearch.boxes) at ANCHORS x ANCHORS grid points (corners,
    middles), each proved or with its undecided volume.
 2. Propagation: every equilibrium known at a grid point is followed along its grid row and its
    grid column to the neighbouring points (continuation.charts.advance), both ways, until no
@@ -284,9 +284,9 @@ def anchor_task(task: tuple) -> dict:
     """One anchor's search (a worker's task: framework, grid index, budget in seconds): its
     chart roots (and, as the solve does, critical points Newton finds next to cone points or in
     boxes left undecided) and what the search decided."""
-    from ..backends.box_shares import split_search
-    from ..backends.boxes import MIN_WIDTH, SHORT
-    from ..backends.real_route import critical_seeds, landscape
+    from ..boxsearch.box_shares import split_search
+    from ..boxsearch.boxes import MIN_WIDTH, SHORT
+    from ..boxsearch.real_route import critical_seeds, landscape
 
     fw, key, seconds = task
     t0 = time.perf_counter()

@@ -69,7 +69,7 @@ def sweep_seeds(
     # process, real_route.real_equilibria): searched here, once, not in a worker each time.
     real = framework_route(fw, settings) == "real"
     if real:  # all crossings searched together, in shared batches of boxes
-        from ..backends.real_route import real_equilibria_of
+        from ..boxsearch.real_route import real_equilibria_of
 
         real_equilibria_of([_crossing(fw, cs, names, spec, t) for spec in vertical for t in ts])
     for part in run_reported(_here if real else run, _solve_line, tasks, stage, "lines", batch):
@@ -162,7 +162,7 @@ def _real_line(task) -> dict:
     """`_solve_line` by the real route: each crossing's real equilibria of the taut set (those
     consistent with its cable states: a branch that becomes consistent between two crossings
     enters through a cable switch), no path lost, and the boxes its search left undecided."""
-    from ..backends.real_route import real_equilibria
+    from ..boxsearch.real_route import real_equilibria
 
     fw, cs, spec, ts, names, _ = task
     out = {}

@@ -1,5 +1,5 @@
-"""Equilibria of a framework on the real route followed in its chart angles (backends.real_route,
-backends.spheres) as two of its parameters change: no polynomial system, no sympy expansion.
+"""Equilibria of a framework on the real route followed in its chart angles (boxsearch.real_route,
+boxsearch.spheres) as two of its parameters change: no polynomial system, no sympy expansion.
 
 `ChartPlane` gives grad V, its Hessian and its parameter derivatives at any chart point and any
 (x, y) of the two parameters (a landscape for each parameter value visited, copied from the
@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..backends.real_route import moved_landscape, new_landscape
+from ..boxsearch.real_route import moved_landscape, new_landscape
 from ..model.framework.spec import Framework, scale_of, slot_kind
 from ..model.framework.units import units
 

@@ -79,7 +79,7 @@ def _cone(fw, cone: dict, value: float, step: float, converged: bool, hi: tuple)
 
 def _cones(fw, param: str, value: float) -> list[dict]:
     from ..analysis.framework_checks import cone_points
-    from ..backends.real_route import covers
+    from ..boxsearch.real_route import covers
 
     if covers(fw) or fw.dim != 2:  # cone points are placed on a circle or torus only
         return []

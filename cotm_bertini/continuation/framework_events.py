@@ -200,7 +200,7 @@ def _real(spec) -> bool:
 
 def _charted(spec) -> bool:
     """The swept framework has chart angles (a circle, torus or product of spheres)."""
-    from ..backends.real_route import covers
+    from ..boxsearch.real_route import covers
 
     return not covers(spec.model)
 

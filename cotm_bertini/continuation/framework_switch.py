@@ -106,7 +106,7 @@ class Follower:
     solve: object
 
     def __call__(self, value: float):
-        from ..backends.real_route import covers
+        from ..boxsearch.real_route import covers
 
         taut = self.cols["taut_set"][self.row]
         key = pose_coordinates(self.fw, self.cols)[self.row]
@@ -123,7 +123,7 @@ def _piece(fw, param: str, value: float, taut: str, cols: dict, row: int) -> dic
     reaches from the body angles of row `row` of `cols` (physical or not)."""
     from ..analysis.framework_classify import framework_columns
     from ..analysis.refine import newton_refine
-    from ..backends.real_route import TorusFramework
+    from ..boxsearch.real_route import TorusFramework
     from ..model.framework.compiled import framework_system
     from ..model.framework.units import normalized_slots, units
 

@@ -74,7 +74,7 @@ def solve_run(
     """
     settings = point_settings(spec)
     if _searched_together(spec, indices, settings):
-        from ..backends.real_route import TOGETHER
+        from ..boxsearch.real_route import TOGETHER
         from ..point import solve_framework_points
 
         for at in range(0, len(indices), TOGETHER):

@@ -1,7 +1,7 @@
 """The real route: a framework whose poses form a circle or torus solved on the reals, by the
 branch and bound of `boxes` over its body angles, with no complex generic set (one whose nodes
-hang by bars, a product of spheres, by backends.spheres; a four-bar's loop by backends.loops;
-nodes held by springs and cables alone over their coordinates, backends.free_nodes: `covers`
+hang by bars, a product of spheres, by boxsearch.spheres; a four-bar's loop by boxsearch.loops;
+nodes held by springs and cables alone over their coordinates, boxsearch.free_nodes: `covers`
 and `landscape` say which).
 
 V = sum k/2 (d - L0)^2 over springs + sum k/2 max(d - L0, 0)^2 over cables - the loads' work, so
@@ -46,7 +46,7 @@ from .boxes import (
     search_each,
 )
 from .cones import ConeParts
-from .endpoints import Endpoints
+from ..backends.endpoints import Endpoints
 from .free_nodes import free_nodes_only, reach
 from .links import (
     EITHER,
@@ -96,10 +96,10 @@ def covers(fw: Framework) -> str:
 @lru_cache(maxsize=8)
 def landscape(fw: Framework, only: str = "all") -> TorusFramework | SphereFramework:
     """V over boxes of the framework's configuration space (covers says which), built once a
-    process: a worker searching several shares of its boxes (backends.box_shares) rebuilds it
+    process: a worker searching several shares of its boxes (boxsearch.box_shares) rebuilds it
     once, and the solve that dealt them not again. `only`: "all" critical points are searched
     for, or the "stable" ones alone (boxes where V can have no local minimum are dropped:
-    backends.stability)."""
+    boxsearch.stability)."""
     if only not in ONLY:
         raise ValueError(f"only = {only!r}: expected one of {ONLY}")
     land = new_landscape(fw)
@@ -131,9 +131,9 @@ def moved_landscape(land, fw: Framework, slots: dict):
 
 class TorusFramework:
     """V of a planar framework pinned in an open chain, over boxes of its body angles; or, for
-    one closing a single loop (backends.loops), the system F whose roots are V's critical points
+    one closing a single loop (boxsearch.loops), the system F whose roots are V's critical points
     on the loop's curve of poses, in the same angles; or, for nodes held by springs and cables
-    alone (backends.free_nodes), V over boxes of their coordinates within a proved bound."""
+    alone (boxsearch.free_nodes), V over boxes of their coordinates within a proved bound."""
 
     only = "all"  # which critical points a search of it looks for (`landscape`)
 
@@ -147,11 +147,11 @@ class TorusFramework:
         self.n = self.full.local_size
         self.bodies = layout(fw).rotations
         self.nodes = () if self.bodies else layout(fw).free_nodes  # coordinates, not angles
-        self.spatial = fw.dim == 3 and bool(self.bodies)  # chart coordinates: backends.rotations
+        self.spatial = fw.dim == 3 and bool(self.bodies)  # chart coordinates: boxsearch.rotations
         self.renumber()
         self.free_springs = [i for i, x in enumerate(self.links) if x.L0 is not None
                              and not x.cable]  # fmt: skip
-        # backends.cones decides boxes through springs' cones (a spring's end moves in the
+        # boxsearch.cones decides boxes through springs' cones (a spring's end moves in the
         # plane as the angles turn: two or more of them)
         self.loop = ClosingPin(self.full) if layout(fw).closing_pins else None
         # (cones: of grad V, not F; a spatial body's cones are not enclosed: such boxes are
@@ -264,7 +264,7 @@ class TorusFramework:
 
     def enclose(self, box: Interval) -> tuple[Interval, Interval, dict]:
         """(squared lengths of the free-length springs, grad V, the cables' states) per box; a
-        loop's F in place of grad V (backends.loops)."""
+        loop's F in place of grad V (boxsearch.loops)."""
         lengths, grad, states = self.enclose_v(box)
         if self.spatial:
             grad = self._centred(box, self.to_chart(self.frames(box), grad)[0], states)
@@ -315,7 +315,7 @@ class TorusFramework:
         return Interval(lo, hi)
 
     def cone_parts(self, box: Interval, spring: np.ndarray) -> ConeParts:
-        """What backends.cones needs of each box about its spring `spring` (an index into the
+        """What boxsearch.cones needs of each box about its spring `spring` (an index into the
         free-length springs, per box) at zero length: V is A's potential minus k L0 d there.
         The Hessians are summed link by link (each link's r is a sum of its bodies' turned
         vectors, so d2r/dangle_j2 is dr/dangle_j a quarter turn on and the rest 0: read off
@@ -354,7 +354,7 @@ class TorusFramework:
 
     def hessian(self, box: Interval, states: dict) -> Interval:
         """The hull of the Hessians of every taut set each box allows (B, n, n); a loop's
-        Jacobian of F (backends.loops)."""
+        Jacobian of F (boxsearch.loops)."""
         hess = self.hessian_v(box, states)
         if self.spatial:
             return self.to_chart(self.frames(box), self.enclose_v(box)[1], hess)[1]
@@ -470,7 +470,7 @@ class TorusFramework:
         return np.hstack([rotations.chart_points(q[:, j]) for j in range(len(self.bodies))])
 
     def frames(self, x) -> list[dict]:
-        """Each spatial body's chart frame (backends.rotations.frame) over boxes or at points."""
+        """Each spatial body's chart frame (boxsearch.rotations.frame) over boxes or at points."""
         return [rotations.frame(x[:, 3 * j : 3 * j + 3]) for j in range(len(self.bodies))]
 
     def quaternions(self, x: np.ndarray) -> np.ndarray:
@@ -480,7 +480,7 @@ class TorusFramework:
 
     def to_chart(self, frames: list, grad, hess=None) -> tuple:
         """(grad V, its Hessian or None) from the generated code's local coordinates to the
-        bodies' chart coordinates (backends.rotations): an Interval (B, n) and (B, n, n) over
+        bodies' chart coordinates (boxsearch.rotations): an Interval (B, n) and (B, n, n) over
         boxes, or arrays at points."""
         Ds = [rotations.jacobian(f) for f in frames]
         g = [grad[:, i] for i in range(self.n)]
@@ -574,7 +574,7 @@ TOGETHER = 32  # frameworks searched in one family (more gain little: 0.010 agai
 class TorusFamily:
     """Frameworks of one structure (TorusFramework.structure: the same systems, units and
     links; other parameter values) as one landscape over boxes that each belong to a member
-    (backends.boxes.search_each): each box's slots, spring stiffnesses and free lengths are
+    (boxsearch.boxes.search_each): each box's slots, spring stiffnesses and free lengths are
     its member's, a number where all members share it (so that the arithmetic is the member's
     own search's), else an array over the boxes."""
 
@@ -592,7 +592,7 @@ class TorusFamily:
     def hull(self) -> TorusFramework:
         """One landscape whose numbers are intervals holding every member's (the slots and
         the links' k and L0): its enclosures hold each member's, so a box it excludes holds
-        no critical point of any member (backends.boxes.cover)."""
+        no critical point of any member (boxsearch.boxes.cover)."""
         view = copy.copy(self.base)
         view.P = [_interval(v) for v in self.P]
         view.links = tuple(
@@ -631,7 +631,7 @@ def search_frameworks(
     max_seconds: float | None = None,
     lands: list[TorusFramework] | None = None,
 ) -> list[BoxSearch]:
-    """The search (defaults of backends.boxes) of each framework, those of one structure
+    """The search (defaults of boxsearch.boxes) of each framework, those of one structure
     together in batches (TorusFamily, search_each): each the same as its own search."""
     lands = lands or [landscape(fw) for fw in fws]
     groups: dict[tuple, list[int]] = {}
@@ -732,7 +732,7 @@ def descent_minima(land, starts: int, seed: int, steps: int = 200) -> np.ndarray
 
 
 def _chart_hessian(frames: list, Ds: list, g: list, hess) -> Interval | np.ndarray:
-    """Hess_u V = D Hess_v V D^T + sum_a g_a W_a (backends.rotations; D block diagonal, a block
+    """Hess_u V = D Hess_v V D^T + sum_a g_a W_a (boxsearch.rotations; D block diagonal, a block
     per body), from Hess_v V (`hess`: (B, n, n) Interval or (R, n, n) array) and grad_v V's
     columns `g`."""
     n, boxes = len(g), isinstance(hess, Interval)

@@ -1,6 +1,6 @@
 """Where V can have a local minimum, over boxes: the tests of a search for the stable
 equilibria alone (`only="stable"`), from an enclosure [H] of V's Hessian over each box (every
-taut set's Hessian the box allows: backends.real_route, backends.spheres).
+taut set's Hessian the box allows: boxsearch.real_route, boxsearch.spheres).
 
 - No minimum in a box: at a local minimum the Hessian is positive semidefinite, so for every
   direction v, v^T H v >= 0 there (where V is only once differentiable, at a cable reaching its

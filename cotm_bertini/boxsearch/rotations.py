@@ -1,5 +1,5 @@
 """Rigid bodies turning in space on the real route: SO(3) covered by four gnomonic charts of the
-unit quaternions (q and -q one rotation), as backends.spheres covers a sphere by two charts.
+unit quaternions (q and -q one rotation), as boxsearch.spheres covers a sphere by two charts.
 
 Chart c (c = 0..3, the quaternion's w, x, y, z) holds the rotations whose component c is the
 largest in magnitude: q = n / |n|, n = e_c + sum_j u_j e_{m_j}, m_0 < m_1 < m_2 the other three
@@ -18,7 +18,7 @@ W_jk = d2v/du_j du_k = -(u_j D_k + u_k D_j) / |n|^2:
     grad_u V = D grad_v V,    Hess_u V = D Hess_v V D^T + sum_a (grad_v V)_a W_a.
 
 Both hold on interval boxes (D and W enclosed from the box's u), so the Krawczyk test of
-backends.boxes applies in chart coordinates unchanged.
+boxsearch.boxes applies in chart coordinates unchanged.
 """
 
 from __future__ import annotations

@@ -5,7 +5,7 @@ A `BoxLandscape` encloses grad V and its Hessian (a valid slope matrix where V i
 smooth) over a batch of boxes, and the squared lengths of the springs with free lengths, where V
 is not smooth at length 0. Each box is
 
-- tested at a spring's cone (backends.cones), where the landscape can (`cone_sets`) and the
+- tested at a spring's cone (boxsearch.cones), where the landscape can (`cone_sets`) and the
   spring's least length over the box is small against its spread there: excluded, or proved
   to hold exactly one cone point (a critical point in Clarke's sense at zero length) and no
   other critical point;
@@ -83,8 +83,8 @@ class BoxLandscape(Protocol):
 
     # Optional: `domain(start) -> (lo, hi)`, the boxes that cover the configuration space
     # (charts of a sphere, say); without it the torus grid of `initial_boxes`.
-    # Optional: `cone_sets` (True) and `cone_parts(box, spring) -> backends.cones.ConeParts`:
-    # boxes through a spring's zero-length poses are tested there (backends.cones).
+    # Optional: `cone_sets` (True) and `cone_parts(box, spring) -> boxsearch.cones.ConeParts`:
+    # boxes through a spring's zero-length poses are tested there (boxsearch.cones).
     # Optional: `free(box, states, grad) -> (code (B, n) int, slack)`: FREE for the angles along
     # which grad V is 0 at every critical point in the box whatever they are (a node with its
     # every element slack and no load), with the cables to take as slack there (`slack`, name
@@ -93,7 +93,7 @@ class BoxLandscape(Protocol):
     # Optional: `contract(box) -> (lo, hi)`, called right after `enclose(box)`: each box shrunk
     # to a box that holds every critical point it holds (lo > hi: none).
     # Optional: `only` ("all"; "stable": a box where V can have no local minimum is dropped,
-    # backends.stability, so that the roots found include every minimum, not every saddle).
+    # boxsearch.stability, so that the roots found include every minimum, not every saddle).
 
 
 class BoxFamily(Protocol):
@@ -127,7 +127,7 @@ class BoxSearch:
     notes: list[str] = field(default_factory=list)
     volume: float = 0.0  # of the domain searched (0: the torus, (2 pi)^n)
     cpu_seconds: float = 0.0  # in every process that searched (`seconds` is the wall time)
-    shares: int = 1  # the shares of boxes searched apart (backends.box_shares), merged here
+    shares: int = 1  # the shares of boxes searched apart (boxsearch.box_shares), merged here
     # Boxes where grad V is 0 along some angles whatever they are (a node whose every element
     # is slack, with no load: V is flat along it), each with exactly one critical point of the
     # other angles, the same for every value of the free ones: pieces of a region of
@@ -137,7 +137,7 @@ class BoxSearch:
     free_points: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     free_masks: np.ndarray = field(default_factory=lambda: np.zeros((0, 0), dtype=bool))
     edge: int = 0  # of the undecided boxes, those at the edge of a free region (EDGE_WIDTH)
-    # Cone points (backends.cones): each a pose where a spring has zero length and V a critical
+    # Cone points (boxsearch.cones): each a pose where a spring has zero length and V a critical
     # point in Clarke's sense, proved alone in its box, no smooth one there. (C, 3n + 3): the
     # angles, the spring (index among those with free lengths), |lambda| (the other elements'
     # pull there, against k L0), the index, the box (lo, hi).
@@ -541,7 +541,7 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, testing) -
         if not cones:  # no test through a cone: a box all shorter than `short` is set aside
             aside |= (dd.hi < short * short).any(axis=1)
         floor = _floor(dd, min_width)
-    if cones:  # boxes through a spring's cone: tested there (backends.cones), not smoothly
+    if cones:  # boxes through a spring's cone: tested there (boxsearch.cones), not smoothly
         near, which = near_cone(dd)
         shortest = np.argmin(dd.lo, axis=1)  # a spring shorter than `short`: its cone rules
         which = np.where(smooth, which, shortest)
@@ -602,7 +602,7 @@ def _step(land: BoxLandscape, lo, hi, short: float, min_width: float, testing) -
 
 
 def _off_loop(land: BoxLandscape, grad: Interval) -> np.ndarray:
-    """The boxes a loop's closure excludes (backends.loops: F's first components are the
+    """The boxes a loop's closure excludes (boxsearch.loops: F's first components are the
     closing pin's mismatch, finite where a spring's 1/d makes the rest unbounded): off the
     loop's curve of poses, whether a spring may be short there or not."""
     loop = getattr(land, "loop", None)
@@ -652,7 +652,7 @@ def _inflated(lo, hi, outer_lo, outer_hi) -> tuple:
 def _tested(land, lo, hi, cand, states, free, slack) -> tuple:
     """The Krawczyk test of the batch's boxes `cand`: (verdict, the roots found as _roots
     gives them, the free pieces (rows, lo hi point mask)). Looking for minima alone (`only`),
-    a box where V can have none (backends.stability, on the test's own slope matrix) is
+    a box where V can have none (boxsearch.stability, on the test's own slope matrix) is
     excluded first."""
     h = _sub(land, cand).hessian(Interval(lo[cand], hi[cand]), _subset(states, cand))
     keep = np.ones(len(cand), dtype=bool)
@@ -689,7 +689,7 @@ def _tested(land, lo, hi, cand, states, free, slack) -> tuple:
 
 
 def _cone_tested(land, lo, hi, at, spring) -> tuple:
-    """backends.cones' test of the batch's boxes `at`, each at its spring's cone: (verdict, the
+    """boxsearch.cones' test of the batch's boxes `at`, each at its spring's cone: (verdict, the
     cone points as (rows, angles spring |lambda| index lo hi))."""
     verdict, (x, lam, index), one = cone_test(_sub(land, at), lo[at], hi[at], spring)
     rows = at[one]

@@ -11,7 +11,7 @@ import numpy as np
 from ..model.framework.spec import Framework
 from ..model.framework.units import normalized_slots
 from ..model.intervals import Interval
-from .endpoints import Endpoints
+from ..backends.endpoints import Endpoints
 
 TAUT, SLACK, EITHER = 1, 0, 2
 

@@ -1,6 +1,6 @@
 """The real route on spheres: a spatial framework whose free nodes each hang by a bar from a
 ground point or from a node hung before it (model.framework.reach.sphere_chain), so that its
-poses form a product of 2-spheres, searched by backends.boxes over charts of each sphere.
+poses form a product of 2-spheres, searched by boxsearch.boxes over charts of each sphere.
 
 Charts. A node's direction u from the point it hangs from is given by two angles (a, b) in one of
 two charts: A, u = (sin a cos b, sin a sin b, cos a), over a band of a that leaves out the poles
@@ -40,7 +40,7 @@ from ..model.framework.spec import Framework, owner, units
 from ..model.framework.units import normalized_slots
 from ..model.intervals import Interval, stack
 from .boxes import EDGE, FREE, NONE, OFFSET
-from .endpoints import Endpoints
+from ..backends.endpoints import Endpoints
 from .links import (
     EITHER,
     SLACK,

@@ -1,7 +1,7 @@
 """The Krawczyk operator over batches of boxes, whatever the system: K(X) = m - Y g(m) +
 (I - Y H(X)) (X - m), Y the inverse of the midpoint of H(X), a slope matrix of g over X. K(X)
 inside the interior of X proves exactly one zero of g in X (it lies in K(X)); K(X) disjoint
-from X proves none (Moore, Krawczyk). backends.boxes tests grad V with it, backends.cones the
+from X proves none (Moore, Krawczyk). boxsearch.boxes tests grad V with it, boxsearch.cones the
 Lagrange system of a spring at zero length."""
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ def krawczyk_step(lo: np.ndarray, hi: np.ndarray, g_mid: Interval, h: Interval,
     """(verdict, K lo, K hi) per box (B, n): 1 exactly one zero, -1 none, 0 unknown. `g_mid`
     encloses g at the boxes' middles, `h` a slope matrix over each box (B, n, n). Along a
     `fixed` coordinate ((B, n) bool) the box is its middle and g is 0 whatever it is (the test
-    is that of the other components: see backends.boxes.krawczyk)."""
+    is that of the other components: see boxsearch.boxes.krawczyk)."""
     n = lo.shape[1]
     fixed = np.zeros(lo.shape, dtype=bool) if fixed is None else fixed
     mid = 0.5 * (lo + hi)

@@ -1,5 +1,5 @@
 """Which critical points a search found are proved local minima: the stable equilibria of a
-search that looked for them alone (`only="stable"`, backends.stability).
+search that looked for them alone (`only="stable"`, boxsearch.stability).
 
 Each point x is wrapped in a box of half-width RADIUS; the Krawczyk test proves exactly one
 critical point in it, and the Hessian's enclosure over it decides: positive definite (a strict

@@ -9,7 +9,7 @@ Jacobian J, nonzero wherever M is smooth):
     F(theta) = (h_x, h_y, t . g) = 0,
 
 three equations in the three angles, with no multiplier to bound. The branch and bound of
-backends.boxes runs on F as on a gradient: F's enclosure excludes boxes, and the Krawczyk test
+boxsearch.boxes runs on F as on a gradient: F's enclosure excludes boxes, and the Krawczyk test
 on F's Jacobian proves each root unique. That Jacobian needs h's second derivatives, which a
 chain of rotating bodies gives for free: along body k's angle, column k of J turns a quarter
 turn (d/dtheta_k of R(theta_k) v is R(theta_k) v turned by pi/2; the other columns do not

@@ -1,4 +1,4 @@
-"""The branch and bound of backends.boxes split over processes: local ones (`workers`) or a
+"""The branch and bound of boxsearch.boxes split over processes: local ones (`workers`) or a
 Dask cluster's (`scheduler`). Boxes are independent (a box's fate is its own), so the start
 boxes, after a few breadth-first steps where they are too few to balance, are dealt round-robin
 into shares (neighbouring boxes to different shares: each gets a similar mix of easy and hard
@@ -21,7 +21,7 @@ from ..errors import SolverError
 from ..model.intervals import Interval
 from ..progress import Progress, silenced
 from .boxes import BATCH, BoxLandscape, BoxSearch, domain, merged, search, spread
-from .pools import as_done, default_workers
+from ..backends.pools import as_done, default_workers
 
 # A worker done early takes another share, and the progress moves a share at a time; but each
 # share walks its boxes down in as many batch steps as the whole search (about 1 ms of numpy's

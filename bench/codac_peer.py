@@ -1,4 +1,4 @@
-"""A peer benchmark of the real route's branch and bound (backends.boxes.search) against codac's
+"""A peer benchmark of the real route's branch and bound (boxsearch.boxes.search) against codac's
 interval branch and contract, side by side in one run on one machine: every critical point of V
 on the torus of body angles [OFFSET, OFFSET + 2 pi]^n of each example, by both.
 
@@ -53,8 +53,8 @@ except ImportError:
     sys.exit("bench/codac_peer.py needs codac: pip install -e .[bench]")
 
 import cotm_bertini as cb
-from cotm_bertini.backends.boxes import MIN_WIDTH, OFFSET, SHORT, TWO_PI, search
-from cotm_bertini.backends.real_route import landscape
+from cotm_bertini.boxsearch.boxes import MIN_WIDTH, OFFSET, SHORT, TWO_PI, search
+from cotm_bertini.boxsearch.real_route import landscape
 from cotm_bertini.model.framework.spec import Framework, owner, units
 from cotm_bertini.model.framework.structure import layout
 
@@ -65,7 +65,7 @@ EXAMPLES = {
     "chain3_collapse": ROOT / "tests" / "fixtures" / "chain3_collapse.toml",
 }
 SPHERES = {"prism_slack": ROOT / "examples" / "prism_slack.toml"}  # in chart angles
-CHART_B = 8.0  # backends.spheres: chart B's first angle is stored 8 higher (a box says its chart)
+CHART_B = 8.0  # boxsearch.spheres: chart B's first angle is stored 8 higher (a box says its chart)
 POSE_TOL = 1e-3  # length units: codac clusters (and our roots) at poses this close are one
 CHECK_POINTS = 20  # random angle vectors at which grad V is compared with the package's
 CHECK_TOL = 1e-9  # largest allowed difference, relative to max(1, |grad V|)

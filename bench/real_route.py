@@ -30,8 +30,8 @@ EXAMPLES = {
 
 def _search_cpu(fw) -> tuple[int, float, int]:
     """(boxes, CPU seconds of the search alone, roots), derivations warm."""
-    from cotm_bertini.backends.boxes import MIN_WIDTH, SHORT, search
-    from cotm_bertini.backends.real_route import TorusFramework
+    from cotm_bertini.boxsearch.boxes import MIN_WIDTH, SHORT, search
+    from cotm_bertini.boxsearch.real_route import TorusFramework
 
     land = TorusFramework(fw)
     _ = land.hessian_sets
@@ -117,13 +117,13 @@ def _xmodule_map() -> dict:
 
 
 def _shared(name: str, workers: int, repeat: int = 3) -> dict:
-    """The search of `name` shared over `workers` local processes (backends.box_shares), warm
+    """The search of `name` shared over `workers` local processes (boxsearch.box_shares), warm
     (derivations cached, the landscape built): best wall of `repeat`, with that run's CPU in
     every process; and the CLI solve end to end with --workers (best of `repeat`)."""
     import cotm_bertini as cb
-    from cotm_bertini.backends.box_shares import split_search
-    from cotm_bertini.backends.boxes import MIN_WIDTH, SHORT
-    from cotm_bertini.backends.real_route import landscape
+    from cotm_bertini.boxsearch.box_shares import split_search
+    from cotm_bertini.boxsearch.boxes import MIN_WIDTH, SHORT
+    from cotm_bertini.boxsearch.real_route import landscape
 
     fw = cb.Framework.from_toml(ROOT / "examples" / f"{name}.toml")
     landscape(fw).hessian_sets  # noqa: B018 (derived here, not in the search's clock)
@@ -148,7 +148,7 @@ def _shared(name: str, workers: int, repeat: int = 3) -> dict:
 def _largest_share_cpu(land, shares: int) -> float:
     """The CPU of the largest of `shares` round-robin shares of the start boxes, each searched
     here alone (best of 3): the wall time the shared search would take on free cores."""
-    from cotm_bertini.backends.boxes import MIN_WIDTH, SHORT, domain, search
+    from cotm_bertini.boxsearch.boxes import MIN_WIDTH, SHORT, domain, search
 
     lo, hi = domain(land, 8)
     best = []

@@ -43,8 +43,8 @@ def run(name: str, budget: float, only: str = "all") -> tuple[dict, np.ndarray]:
     """One example's search (for `only`: "all" critical points, or the "stable" ones): its row
     of the table, and its roots."""
     import cotm_bertini as cb
-    from cotm_bertini.backends.boxes import MIN_WIDTH, SHORT, search
-    from cotm_bertini.backends.real_route import new_landscape
+    from cotm_bertini.boxsearch.boxes import MIN_WIDTH, SHORT, search
+    from cotm_bertini.boxsearch.real_route import new_landscape
 
     fw = cb.Framework.from_toml(ROOT / FILES[name])
     if name in SETS:
@@ -68,7 +68,7 @@ def run(name: str, budget: float, only: str = "all") -> tuple[dict, np.ndarray]:
 def minima(name: str, roots: np.ndarray) -> np.ndarray:
     """The roots where the Hessian (double precision) is positive definite."""
     import cotm_bertini as cb
-    from cotm_bertini.backends.real_route import new_landscape
+    from cotm_bertini.boxsearch.real_route import new_landscape
 
     fw = cb.Framework.from_toml(ROOT / FILES[name])
     if not len(roots):

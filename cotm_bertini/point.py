@@ -18,9 +18,9 @@ import numpy as np
 
 from .analysis.classify import classify_columns
 from .analysis.morse import morse_check
-from .boxsearch.boxes import MIN_WIDTH
 from .backends.crossings import in_solve
 from .backends.endpoints import Endpoints
+from .boxsearch.boxes import MIN_WIDTH
 from .errors import ParameterError
 from .model.compiled import parametric_system
 from .model.framework.structure import layout as model_layout

@@ -17,11 +17,11 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ..backends.pools import as_done, default_workers
 from ..errors import SolverError
 from ..model.intervals import Interval
 from ..progress import Progress, silenced
 from .boxes import BATCH, BoxLandscape, BoxSearch, domain, merged, search, spread
-from ..backends.pools import as_done, default_workers
 
 # A worker done early takes another share, and the progress moves a share at a time; but each
 # share walks its boxes down in as many batch steps as the whole search (about 1 ms of numpy's

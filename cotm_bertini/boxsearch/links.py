@@ -8,10 +8,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..backends.endpoints import Endpoints
 from ..model.framework.spec import Framework
 from ..model.framework.units import normalized_slots
 from ..model.intervals import Interval
-from ..backends.endpoints import Endpoints
 
 TAUT, SLACK, EITHER = 1, 0, 2
 

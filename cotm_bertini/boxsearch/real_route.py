@@ -26,6 +26,7 @@ from functools import cached_property, lru_cache
 
 import numpy as np
 
+from ..backends.endpoints import Endpoints
 from ..model.framework.ballcode import ball_module
 from ..model.framework.compiled import FrameworkSystem, framework_system, slot_vector
 from ..model.framework.reach import cable_states, sphere_chain
@@ -46,7 +47,6 @@ from .boxes import (
     search_each,
 )
 from .cones import ConeParts
-from ..backends.endpoints import Endpoints
 from .free_nodes import free_nodes_only, reach
 from .links import (
     EITHER,

@@ -33,6 +33,7 @@ from functools import cached_property
 
 import numpy as np
 
+from ..backends.endpoints import Endpoints
 from ..model.framework.ballcode import ball_module
 from ..model.framework.compiled import FrameworkSystem, framework_system, slot_vector
 from ..model.framework.reach import sphere_chain
@@ -40,7 +41,6 @@ from ..model.framework.spec import Framework, owner, units
 from ..model.framework.units import normalized_slots
 from ..model.intervals import Interval, stack
 from .boxes import EDGE, FREE, NONE, OFFSET
-from ..backends.endpoints import Endpoints
 from .links import (
     EITHER,
     SLACK,

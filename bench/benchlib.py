@@ -163,8 +163,8 @@ def example_system(name: str, taut: tuple[str, ...] | None = None):
     equilibria), its start centre and groups."""
     import cotm_bertini as cb
     from cotm_bertini.model.framework.compiled import framework_system, variable_groups
+    from cotm_bertini.model.framework.taut_sets import taut_sets
     from cotm_bertini.model.framework.units import normalized_slots
-    from cotm_bertini.point import taut_sets
 
     fw = cb.Framework.from_toml(BENCH.parent / "examples" / f"{name}.toml")
     if taut is not None:

@@ -74,7 +74,8 @@ def one_framework(name: str, repeat: int = 1) -> dict:
     run is the nearest to each one's own cost)."""
     import cotm_bertini as cb
     from cotm_bertini.analysis.certify.framework import certify_framework_table
-    from cotm_bertini.point import framework_route, solve_framework_point
+    from cotm_bertini.point import solve_framework_point
+    from cotm_bertini.routes import choose
     from cotm_bertini.settings import Settings
 
     fw = cb.Framework.from_toml(FILES[name]).replace(**FRAMEWORKS[name])
@@ -87,7 +88,7 @@ def one_framework(name: str, repeat: int = 1) -> dict:
         certs.append(certify_framework_table(fw, solved.columns))
     cert = min(certs, key=lambda c: c.seconds)
     return {
-        "framework": name, "route": framework_route(fw, Settings()), "solve_s": min(solves),
+        "framework": name, "route": choose(fw, Settings()).route, "solve_s": min(solves),
         "certify_s": cert.seconds, "ratio": cert.seconds / min(solves),
         "rows_s": cert.timings["rows"], "complete_s": cert.timings["completeness"],
         "status": cert.status, "equilibria": cert.proved_equilibria,

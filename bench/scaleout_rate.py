@@ -31,8 +31,8 @@ def _smallest_set(name: str):
     from cotm_bertini.backends.homotopy import generic_start
     from cotm_bertini.backends.path_progress import path_count
     from cotm_bertini.model.framework.compiled import framework_system, variable_groups
+    from cotm_bertini.model.framework.taut_sets import taut_sets
     from cotm_bertini.model.framework.units import normalized_slots
-    from cotm_bertini.point import taut_sets
 
     fw = cb.Framework.from_toml(ROOT / "examples" / f"{name}.toml")
     slots = normalized_slots(fw.at_defaults())

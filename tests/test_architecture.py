@@ -8,7 +8,8 @@ from pathlib import Path
 PACKAGE = Path(__file__).resolve().parent.parent / "cotm_bertini"
 
 # Lower layers never import higher ones (data flows params -> model -> backends -> boxsearch ->
-# analysis -> point -> continuation -> catastrophe/motion -> io/plot -> api -> paper -> cli).
+# analysis -> routes -> point -> continuation -> catastrophe/motion -> io/plot -> api -> paper
+# -> cli).
 LAYERS = [
     {"_version", "errors", "fs", "versions", "resources", "columns", "literals", "progress"},
     {"params", "settings"},
@@ -16,6 +17,7 @@ LAYERS = [
     {"backends"},
     {"boxsearch"},
     {"analysis"},
+    {"routes"},
     {"point"},
     {"continuation"},
     {"catastrophe", "motion"},

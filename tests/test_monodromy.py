@@ -52,8 +52,8 @@ def total_degree(system, groups=None) -> tuple[np.ndarray, int, int]:
 def framework(name: str):
     """The first taut set's system of examples/<name>.toml, its start centre and groups."""
     from cotm_bertini.model.framework.compiled import framework_system, variable_groups
+    from cotm_bertini.model.framework.taut_sets import taut_sets
     from cotm_bertini.model.framework.units import normalized_slots
-    from cotm_bertini.point import taut_sets
 
     fw = cb.Framework.from_toml(ROOT / "examples" / f"{name}.toml")
     fs = next(f for f in (framework_system(fw, t) for t in taut_sets(fw)) if not f.free)
@@ -117,7 +117,7 @@ def _example_sets() -> list[tuple[str, tuple[str, ...]]]:
     docs/benchmarks.md) and the spatial ones of issue 29 (46,656 to 6e12 paths a set:
     docs/frameworks.md), which tests/test_spatial_examples.py checks against their own route."""
     from cotm_bertini.model.framework.compiled import framework_system
-    from cotm_bertini.point import taut_sets
+    from cotm_bertini.model.framework.taut_sets import taut_sets
 
     out = []
     for path in sorted((ROOT / "examples").glob("*.toml")):

@@ -12,7 +12,7 @@ from conftest import ROOT
 
 import cotm_bertini as cb
 from cotm_bertini.model.framework import prune as prune_module
-from cotm_bertini.point import pruned_taut_sets, taut_sets
+from cotm_bertini.model.framework.taut_sets import pruned_taut_sets, taut_sets
 
 # A planar node N held by a spring of zero free length to g3 and by two cables in series
 # between g1 and g2, 3 apart: both slack would need |g1 - g2| <= 1 + 1.2 = 2.2.

@@ -21,8 +21,8 @@ import cotm_bertini as cb
 from cotm_bertini.backends import homotopy
 from cotm_bertini.backends.start_system import linear_product_start
 from cotm_bertini.model.framework.compiled import framework_system, variable_groups
+from cotm_bertini.model.framework.taut_sets import taut_sets
 from cotm_bertini.model.polynomial import PolySystem
-from cotm_bertini.point import taut_sets
 
 ZEEMAN = ROOT / "examples" / "zeeman.toml"
 CONNECT = "DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT"  # Dask's own connect timeout

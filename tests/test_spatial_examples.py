@@ -246,7 +246,7 @@ def test_descents_from_random_poses_reach_only_the_references_minima(name):
 def _package_sets(name: str) -> tuple[list, dict]:
     """The package's (taut_sets, pruned_taut_sets) of the example at its file's values."""
     import cotm_bertini as cb
-    from cotm_bertini.point import split_taut_sets
+    from cotm_bertini.model.framework.taut_sets import split_taut_sets
 
     return split_taut_sets(cb.Framework.from_toml(ROOT / "examples" / f"{name}.toml"))
 

@@ -25,7 +25,7 @@ def _bezout_counts(fw) -> list[int]:
     """Each taut set's multihomogeneous Bezout number, in cost's order (framework_system's
     equations, counted here from their exponents)."""
     from cotm_bertini.model.framework.compiled import framework_system, variable_groups
-    from cotm_bertini.point import split_taut_sets
+    from cotm_bertini.model.framework.taut_sets import split_taut_sets
 
     out = []
     for taut in split_taut_sets(fw)[0]:

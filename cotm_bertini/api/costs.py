@@ -238,10 +238,10 @@ def cost(fw, settings: Settings | None = None, *, sample: bool | None = True) ->
     earlier solve in this process, or a fixed prior); None, sample only when the first guess
     is beyond SAMPLE_FROM seconds."""
     from ..backends.path_progress import first_guess, remember
-    from ..point import framework_route
+    from ..routes import choose
 
     settings = settings or Settings()
-    if framework_route(fw, settings) == "real":
+    if choose(fw, settings).real:
         probe = _search_sample(fw) if sample is True else None
         return Cost(fw.name, (), (settings.seed,), 0.0, "no generic set", False, 0.0, "real",
                     search=probe)  # fmt: skip
@@ -292,8 +292,8 @@ def _sets(fw, settings: Settings) -> tuple[list[SetCost], list[tuple], int]:
     from ..backends.monodromy import ROUTE
     from ..backends.path_progress import path_count
     from ..model.framework.compiled import framework_system, variable_groups
+    from ..model.framework.taut_sets import split_taut_sets
     from ..model.framework.units import normalized_slots
-    from ..point import split_taut_sets
 
     slots = normalized_slots(fw.at_defaults())  # the generic sets' centre, as a solve has it
     tauts, pruned = split_taut_sets(fw)

@@ -107,7 +107,7 @@ def design_map(
     (a 2-D sweep), "continuation" (catastrophe/chart_map.py) or "auto" (grid_route)."""
     from ..backends.pools import check_workers
     from ..continuation.spec import check_grid
-    from ..point import check_route
+    from ..routes.choice import check_route
     from .sweeps import sweep
 
     (x, xr), (y, yr), points = map_axes(model, axes, l01, l02, points)
@@ -201,11 +201,11 @@ def grid_route(model, grid: str, settings: Settings) -> str:
     of every point where only the stable equilibria are asked for); or a one-line refusal."""
     from ..boxsearch.real_route import covers
     from ..errors import ParameterError
-    from ..point import framework_route
+    from ..routes import choose
 
     if grid not in GRIDS:
         raise ParameterError(f"grid = {grid!r}: not a grid route ({', '.join(GRIDS)})")
-    real = not isinstance(model, Params) and framework_route(model, settings) == "real"
+    real = not isinstance(model, Params) and choose(model, settings).real
     real = real and _followed(model)
     if grid == "continuation" and not real:
         raise ParameterError("grid = 'continuation': only for a framework on the real route "

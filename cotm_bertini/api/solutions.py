@@ -200,7 +200,7 @@ def solve(
             record["cache"] = {"hit": True, "key": key, "solved": record.get("solved"),
                                "seconds": time.perf_counter() - start}  # fmt: skip
             return Solutions(params, settings, record, hit)
-    from ..point import check_route  # after the cache: a hit loads no numpy
+    from ..routes.choice import check_route
 
     check_route(params, settings)  # a refused request has no cached answer; refused here
     if settings.scheduler is not None:  # an address nobody answers: refused before any work

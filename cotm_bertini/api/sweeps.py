@@ -139,7 +139,7 @@ def sweep(
     """
     from ..continuation.runner import check_workers, prepare
     from ..continuation.spec import SweepSpec, check_grid
-    from ..point import check_route
+    from ..routes.choice import check_route
 
     check_workers(workers)  # before any folder is made
     settings = (settings or Settings()).replace(**options)

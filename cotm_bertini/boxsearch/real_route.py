@@ -1,8 +1,9 @@
 """The real route: a framework whose poses form a circle or torus solved on the reals, by the
 branch and bound of `boxes` over its body angles, with no complex generic set (one whose nodes
 hang by bars, a product of spheres, by boxsearch.spheres; a four-bar's loop by boxsearch.loops;
-nodes held by springs and cables alone over their coordinates, boxsearch.free_nodes: `covers`
-and `landscape` say which).
+nodes held by springs and cables alone over their coordinates, boxsearch.free_nodes; bodies in
+space on ball joints over quaternion charts, boxsearch.rotations: `covers` and `landscape` say
+which).
 
 V = sum k/2 (d - L0)^2 over springs + sum k/2 max(d - L0, 0)^2 over cables - the loads' work, so
 grad V = sum w r . dr/dangle + the loads' gradient, w = k (1 - L0/d) for a spring (k at zero free
@@ -81,7 +82,8 @@ CENTRED = 0.1
 def covers(fw: Framework) -> str:
     """'' where the real route covers the framework's configuration space (a circle or torus
     of planar bodies' angles, a four-bar's loop, a product of spheres of nodes hung on bars,
-    or nodes held by springs and cables alone), else why not."""
+    nodes held by springs and cables alone, or bodies in space on ball joints), else why
+    not."""
     why = free_nodes_only(fw)
     lay = layout(fw)
     if not why or (lay.free_nodes and not (lay.rotations or lay.translations or fw.bars)):
@@ -133,7 +135,9 @@ class TorusFramework:
     """V of a planar framework pinned in an open chain, over boxes of its body angles; or, for
     one closing a single loop (boxsearch.loops), the system F whose roots are V's critical points
     on the loop's curve of poses, in the same angles; or, for nodes held by springs and cables
-    alone (boxsearch.free_nodes), V over boxes of their coordinates within a proved bound."""
+    alone (boxsearch.free_nodes), V over boxes of their coordinates within a proved bound; or,
+    for bodies in space on ball joints, V over boxes of their quaternion charts
+    (boxsearch.rotations)."""
 
     only = "all"  # which critical points a search of it looks for (`landscape`)
 

@@ -89,7 +89,7 @@ def _grid_rows(fw: Framework, plane: ChartPlane, x: str, xs, y: str, ys, known: 
     """Each grid point's rows, classified as a solve's (point.real_table), with its index and
     the swept values; and the grid points whose Morse sum fails."""
     from ..analysis.framework_checks import morse_count
-    from ..point import real_table
+    from ..routes.real import real_table
 
     frames, failed = [], []
     report = Progress("map: grid points classified", len(xs) * len(ys), "points")

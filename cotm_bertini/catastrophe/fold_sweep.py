@@ -25,8 +25,8 @@ from ..model.framework.folds import CurveSystem
 from ..model.framework.spec import Framework
 from ..model.framework.units import normalized_slots
 from ..model.polynomial import PolySystem
-from ..point import framework_route
 from ..progress import Progress
+from ..routes import choose
 from ..settings import Settings, Tolerances
 from .curve_trace import Traced, Window, newton, remembered, trace, turning_point
 
@@ -67,7 +67,7 @@ def sweep_seeds(
     stage = f"{what}: equilibria at {len(vertical)} x {len(ts)} crossings, by vertical line"
     # On the real route a crossing's search serves every curve system of the map (kept in this
     # process, real_route.real_equilibria): searched here, once, not in a worker each time.
-    real = framework_route(fw, settings) == "real"
+    real = choose(fw, settings).real
     if real:  # all crossings searched together, in shared batches of boxes
         from ..boxsearch.real_route import real_equilibria_of
 
@@ -127,7 +127,7 @@ def _generic_sets(task) -> None:
     from ..backends.generic import evidence_sets
 
     fw, cs, settings = task
-    if framework_route(fw, settings) == "real":
+    if choose(fw, settings).real:
         return  # the crossings' equilibria come from the real route: no generic set
     fs = framework_system(fw.at_defaults(), cs.taut)
     slots = normalized_slots(fw.at_defaults())
@@ -142,7 +142,7 @@ def _solve_line(task) -> dict:
 
     fw, cs, spec, ts, names, settings = task
     sx, sy = cs.scales
-    if framework_route(fw, settings) == "real":
+    if choose(fw, settings).real:
         return _real_line(task)
     centre = normalized_slots(fw.at_defaults())
     out, warm = {}, None

@@ -55,8 +55,8 @@ from ..model.framework.folds import (
 )
 from ..model.framework.spec import Framework
 from ..model.framework.units import normalized_slots, units
-from ..point import framework_route
 from ..progress import Progress, say
+from ..routes import choose
 from ..settings import Settings, Tolerances
 from .curve_trace import Traced, Window, trace, turning_point
 from .fold_sweep import curve_equations, is_real, long_enough, run_reported, sweep_seeds
@@ -172,7 +172,7 @@ def _window_taut_sets(fw: Framework, xname: str, xrange, yname: str, yrange) -> 
     """The taut sets that can occur somewhere in the window: those of any of TAUT_GRID x
     TAUT_GRID points of it (corners included; a cable always taut at the centre may go slack
     near an edge), all taut first as point.taut_sets orders them."""
-    from ..point import taut_sets
+    from ..model.framework.taut_sets import taut_sets
 
     found: set[tuple[str, ...]] = set()
     for x in np.linspace(*xrange, TAUT_GRID):
@@ -263,7 +263,7 @@ def _find(
     groups = _groups(cs, settings.seed)
     paths = bezout_number(_degrees(cs, settings.seed, groups), [len(g) for g in groups])
     route = seeds if seeds != "auto" else "witness" if paths <= WITNESS_MAX_PATHS else "sweep"
-    if seeds == "auto" and framework_route(fw, settings) == "real":
+    if seeds == "auto" and choose(fw, settings).real:
         route = "sweep"  # each crossing's real equilibria by the real route: no witness set
     if cs.kind == "relaxed":
         route = "witness"  # module docstring: a sweep cannot tell relaxed folds from others

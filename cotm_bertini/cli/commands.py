@@ -262,7 +262,7 @@ def verify(args: argparse.Namespace) -> int:
     from ..analysis.verify import verify as verify_routes
     from ..api.solutions import solve as solve_params
     from ..fs import write_json
-    from ..point import check_route
+    from ..routes.choice import check_route
 
     params, label = params_from(args), label_of(args)
     settings = settings_from(args)

@@ -145,8 +145,8 @@ def warm_generic_sets(fw_at, indices: list[int], settings) -> None:
     now is split over its scheduler, if given)."""
     from ..backends.generic import evidence_sets
     from ..model.framework.compiled import framework_system, variable_groups
+    from ..model.framework.taut_sets import taut_sets
     from ..model.framework.units import normalized_slots
-    from ..point import taut_sets
 
     for index in indices:
         fw = fw_at(index)

@@ -192,10 +192,10 @@ def _minima_only(spec) -> bool:
 
 def _real(spec) -> bool:
     """The sweep's points are solved on the real route."""
-    from ..point import framework_route
+    from ..routes import choose
     from .runner import point_settings
 
-    return framework_route(spec.model, point_settings(spec)) == "real"
+    return choose(spec.model, point_settings(spec)).real
 
 
 def _charted(spec) -> bool:

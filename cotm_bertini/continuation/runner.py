@@ -23,7 +23,8 @@ from ..backends.pools import worker_pool as worker_pool
 from ..errors import ParameterError
 from ..fs import write_json
 from ..params import Params
-from ..point import PointSolution, solve_point
+from ..point import solve_point
+from ..routes.result import PointSolution
 from ..settings import Settings
 from .spec import SweepSpec
 from .store import PointStore, stored_indices
@@ -101,9 +102,9 @@ def _searched_together(spec: SweepSpec, indices: list[int], settings: Settings) 
     not Python's steps, set the pace; each point's search and rows as if solved alone)."""
     if spec.framework is None or not indices:
         return False
-    from ..point import framework_route
+    from ..routes import choose
 
-    return framework_route(spec.params_at(indices[0]), settings) == "real"
+    return choose(spec.params_at(indices[0]), settings).real
 
 
 def _point_out(
@@ -237,10 +238,10 @@ def warm_generic_sets(spec: SweepSpec, scheduler: str | None = None) -> None:
     if scheduler:
         settings = settings.replace(scheduler=scheduler)
     if spec.framework is not None:
-        from ..point import framework_route
+        from ..routes import choose
         from .framework import warm_generic_sets as framework_sets
 
-        if framework_route(spec.params_at(0), settings) == "real":
+        if choose(spec.params_at(0), settings).real:
             return  # the real route solves no generic set
 
         framework_sets(spec.params_at, sorted({0, spec.size() - 1}), settings)

@@ -13,7 +13,7 @@ from ..fs import atomic_write_text, columns_csv, partial_name, timestamp, write_
 from ..versions import versions
 
 if TYPE_CHECKING:  # the solve path only: a cache hit must not load numpy or pandas
-    from ..point import PointSolution
+    from ..routes.result import PointSolution
 
 SOLUTIONS_CSV = "solutions.csv"
 CONTINUA_CSV = "continua.csv"

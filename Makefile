@@ -86,3 +86,27 @@ format: $(STAMP)
 
 clean-runs:
 	find runs -mindepth 1 -maxdepth 1 ! -name README.md -exec rm -rf {} +
+
+# The pictures of README.md and docs/design.md, docs/img/<name>.png, each made by the command on
+# the line above its copy; run before a release (not in CI, not in `make test`). Every command
+# writes into a scratch folder with an empty cache of its own (so nothing stale is drawn); only
+# the PNG is kept, the folder is removed. About 2 minutes on 2 cores, most of it the map.
+# (docs/img/explore-plan.png is a browser screenshot taken by tests/test_explore.py.)
+.PHONY: figures
+FIGURES_TMP ?= /tmp/cotm-bertini-figures
+figures: export COTM_CACHE := $(FIGURES_TMP)/cache
+figures: $(STAMP)
+	rm -rf $(FIGURES_TMP) && mkdir -p $(FIGURES_TMP) docs/img
+	$(CLI) solve case3 --out $(FIGURES_TMP)/case3
+	cp $(FIGURES_TMP)/case3/latest/configurations.png docs/img/case3-equilibria.png
+	$(CLI) sweep --param L01 --from 0 --to 12 --points 241 --out $(FIGURES_TMP)/sweep
+	cp $(FIGURES_TMP)/sweep/sweep-L01-*/bifurcation.png docs/img/sweep-L01.png
+	$(CLI) map --out $(FIGURES_TMP)/map
+	cp $(FIGURES_TMP)/map/latest/map.png docs/img/design-map.png
+	$(CLI) solve --framework examples/prism_slack.toml --out $(FIGURES_TMP)/prism
+	cp $(FIGURES_TMP)/prism/latest/configurations.png docs/img/prism-slack-equilibria.png
+	$(CLI) move --framework examples/zeeman.toml --set x=0.1 --state 1 --path y=-0.8,0.2,-0.8 --out $(FIGURES_TMP)/move
+	cp $(FIGURES_TMP)/move/latest/move.png docs/img/zeeman-move.png
+	$(CLI) plan --framework examples/zeeman.toml --set x=0.1 --set y=-0.25 --state 1 --goal 2 --param x --from -0.6 --to 0.8 --param2 y --from2 -0.8 --to2 0.2 --out $(FIGURES_TMP)/plan
+	cp $(FIGURES_TMP)/plan/latest/plan.png docs/img/zeeman-plan.png
+	rm -rf $(FIGURES_TMP)

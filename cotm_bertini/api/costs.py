@@ -69,6 +69,7 @@ class Cost:
     # `sets` count the total-degree set of the seed, the monodromy one is not counted
     pruned: int = 0  # taut sets no pose can hold (point.pruned_taut_sets): not in `sets`
     search: dict | None = None  # the real route's sample search (_search_sample), if run
+    why: str = ""  # why the route was chosen (routes.choose)
 
     @property
     def paths(self) -> int:
@@ -107,10 +108,12 @@ class Cost:
     def headline(self) -> str:
         """One line: the total work and its estimate (the first line of a solve)."""
         if self.route == "real":
+            from ..routes import PROVES
+
             return (
-                f"{self.name}: the real route (a branch and bound over its configuration space, "
-                "real equilibria only, proved complete; no generic set to solve; --route complex "
-                "solves every complex root of every taut set instead)" + _paced(self.search)
+                f"{self.name}: the real route ({PROVES['real']}; chosen: {self.why}; no "
+                "generic set to solve; --route complex solves every complex root of every taut "
+                "set instead)" + _paced(self.search)
             )
         solved = [s for s in self.sets if not s.free]
         tracked = [s for s in solved if s.route != "monodromy"]  # paths counted beforehand
@@ -241,10 +244,11 @@ def cost(fw, settings: Settings | None = None, *, sample: bool | None = True) ->
     from ..routes import choose
 
     settings = settings or Settings()
-    if choose(fw, settings).real:
+    choice = choose(fw, settings)
+    if choice.real:
         probe = _search_sample(fw) if sample is True else None
         return Cost(fw.name, (), (settings.seed,), 0.0, "no generic set", False, 0.0, "real",
-                    search=probe)  # fmt: skip
+                    search=probe, why=choice.why)  # fmt: skip
     t0 = time.perf_counter()
     sets, systems, pruned = _sets(fw, settings)
     derive_seconds = time.perf_counter() - t0
@@ -280,7 +284,8 @@ def cost(fw, settings: Settings | None = None, *, sample: bool | None = True) ->
     routes = {s.route for s in sets if not s.free} or {"total-degree"}
     route = routes.pop() if len(routes) == 1 else "mixed"
     seeds = max((s.seeds for s in sets), key=len, default=(settings.seed,))
-    return Cost(fw.name, tuple(sets), seeds, rate, source, measured, derive_seconds, route, pruned)
+    return Cost(fw.name, tuple(sets), seeds, rate, source, measured, derive_seconds, route, pruned,
+                why=choice.why)  # fmt: skip
 
 
 def _sets(fw, settings: Settings) -> tuple[list[SetCost], list[tuple], int]:

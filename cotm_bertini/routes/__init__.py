@@ -14,6 +14,6 @@ chooses among them (`choose`, routes/choice.py).
 Each returns a routes.result.PointSolution: the classified rows, counts, checks and status.
 """
 
-from .choice import Choice, choose
+from .choice import PROVES, Choice, choose
 
-__all__ = ["Choice", "choose"]
+__all__ = ["PROVES", "Choice", "choose"]

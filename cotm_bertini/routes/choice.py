@@ -10,6 +10,17 @@ from ..model.framework.structure import layout as model_layout
 from ..params import Params
 from ..settings import Settings
 
+# What each route proves (routes/__init__.py), as the cost statement and the docs say it.
+PROVES = {
+    "real": "a branch and bound over its configuration space in interval arithmetic: every real "
+    "equilibrium, proved complete where every box is decided",
+    "homotopy": "Bertini 2 in-process, a parameter homotopy from a cached generic set: every "
+    "complex root of every taut set, complete where the generic set is (trace test, or two "
+    "seeds that agree)",
+    "command": "the bertini2 command or a Bertini 1.x binary: every complex root its homotopy "
+    "reaches, checked by its path counts and the Morse count",
+}
+
 
 @dataclass(frozen=True)
 class Choice:
@@ -22,6 +33,11 @@ class Choice:
     def real(self) -> bool:
         """Whether it is the real route."""
         return self.route == "real"
+
+    @property
+    def proves(self) -> str:
+        """What the route finds and proves (PROVES)."""
+        return PROVES[self.route]
 
 
 def check_route(model, settings: Settings, what: str = "solve") -> None:
@@ -118,5 +134,4 @@ def choose(model, settings: Settings) -> Choice:
     if settings.generic:
         return Choice("homotopy", f"generic = {settings.generic!r} asked for (a generic set "
                       "is the homotopy's)")  # fmt: skip
-    return Choice("real", "the real route covers its configuration space: every real "
-                  "equilibrium, proved")  # fmt: skip
+    return Choice("real", "the default where the real route covers the configuration space")

@@ -102,3 +102,19 @@ def test_uncovered_spatial_body_is_refused(tmp_path) -> None:
     path.write_text(text.replace('[[pins]]\na = "b.o"\nb = "ground.o"\n', ""))
     with pytest.raises(ValueError, match="pinned nowhere"):
         cb.solve(cb.Framework.from_toml(path), settings=cb.Settings(route="real"))
+
+
+def test_a_spring_that_can_collapse_takes_the_complex_route(tmp_path) -> None:
+    """A spring of a body in space that can reach zero length (its anchor as far from the pivot
+    as its body point): the real route does not enclose its cone, so it is not the default, and
+    asking for it is refused in one line naming the spring."""
+    from cotm_bertini.routes import choose
+
+    text = (ROOT / "examples" / "ball_joint.toml").read_text()
+    # mast.left is at |(0.5, 0, 1)| = sqrt(1.25) from the pivot; so is this anchor
+    path = tmp_path / "collapsing.toml"
+    path.write_text(text.replace("a = [1.1, 0.3, 0.9]", "a = [0.5, 1.0, 0.0]"))
+    fw = cb.Framework.from_toml(path)
+    assert choose(fw, cb.Settings()).route == "homotopy"
+    with pytest.raises(ValueError, match="spring sa of a body in space can reach zero length"):
+        cb.solve(fw, route="real")

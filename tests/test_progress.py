@@ -198,7 +198,9 @@ def test_certificate_search_reports_the_share_decided(monkeypatch, capsys):
 
 def test_sweep_lines_carry_the_measured_rate(tmp_path):
     """A sweep off a terminal, a line per point (interval 0): each before the last with the
-    rate (the time so far over the points done) and the time left; the last the count."""
+    rate and the time left at it; the last the count. The rate is the time so far over the
+    points done, or, where the first point took more than ONE_OFF times as long as the later
+    ones (its one-off costs), the later points' pace: never more than the average then."""
     env = {progress.ENV_SECONDS: "0"}
     res = run_cli("sweep", "--from", "1", "--to", "2", "--points", "3", "--workers", "1",
                   "--no-plots", "--out", str(tmp_path), env=env)  # fmt: skip
@@ -210,7 +212,10 @@ def test_sweep_lines_carry_the_measured_rate(tmp_path):
                          r"so far, about ([\d.]+) s left", line)  # fmt: skip
         assert m, line
         rate, so_far, left = map(float, m.groups())
-        assert rate == pytest.approx(so_far / k, rel=0.15, abs=0.02)
+        if k == 1:
+            assert rate == pytest.approx(so_far, rel=0.15, abs=0.02)
+        else:
+            assert rate <= so_far / k * 1.15 + 0.02
         assert left == pytest.approx(rate * (3 - k), rel=0.15, abs=0.02)
     assert len(lines) == 3
 
@@ -274,3 +279,24 @@ def test_a_long_time_left_is_said_in_days_or_years():
     assert progress.duration(40 * 86400) == "40 days"
     assert progress.duration(3 * 365.25 * 86400) == "3.0 years"
     assert progress.duration(12_428_446 * 3600) == f"{12_428_446 / 24 / 365.25:,.0f} years"
+
+
+def test_a_first_unit_with_one_off_costs_does_not_set_the_pace(monkeypatch):
+    """A first point that carried one-off costs (20 s) and later ones at 0.1 s: the time left
+    is at the later pace, not at the average (which would say some 2 hours for 1,000 points
+    where 100 s are left); points of one pace keep the average."""
+    clock = [0.0]
+    monkeypatch.setattr(progress.time, "perf_counter", lambda: clock[0])
+    p = progress.Progress("map", 1002, "points", delay=1e9)
+    clock[0] = 20.0
+    p.update(1)
+    assert p.rate == pytest.approx(20.0)  # one unit: nothing else to go by
+    for _ in range(10):
+        clock[0] += 0.1
+        p.update(1)
+    assert p.rate == pytest.approx(0.1) and p.left == pytest.approx(0.1 * 991)
+    even = progress.Progress("sweep", 10, "points", delay=1e9)
+    for k in range(4):
+        clock[0] += 1.0 + 0.2 * (k % 2)
+        even.update(1)
+    assert even.rate == pytest.approx(even.elapsed / 4)

@@ -24,6 +24,7 @@ ENV_DELAY = "COTM_PROGRESS_DELAY"  # seconds a stage nobody announced runs befor
 LINE_SECONDS = 5.0
 DELAY = 5.0
 ONE_OFF = 3.0  # the first units' pace this many times the later ones': not the pace to come
+ONE_OFF_MOST = 10  # units left beyond which one unit done gives no time left
 WINDOW = 10.0  # seconds at least: a fraction's time left is at the rate of its last window
 OFF = ("0", "no", "off", "false")
 
@@ -195,6 +196,8 @@ class Progress:
             return None
         if isinstance(self.total, float):
             return self._window_left()
+        if self.done - self.initial <= 1 and self.total - self.done > ONE_OFF_MOST:
+            return None  # one unit of many: it may have carried one-off costs (`rate`)
         rate = self.rate
         return None if rate is None else max(0.0, rate * (self.total - self.done))
 
@@ -299,7 +302,7 @@ class Progress:
             parts.append(f"at least about {duration(left)} left (the pace is falling)")
         elif left is not None:
             parts.append(f"about {duration(left)} left")
-        elif isinstance(self.total, float):
+        elif self.total is not None:
             parts.append("time left not known yet")
         return f"{text}; {', '.join(parts)}"
 

@@ -290,7 +290,8 @@ def test_a_first_unit_with_one_off_costs_does_not_set_the_pace(monkeypatch):
     p = progress.Progress("map", 1002, "points", delay=1e9)
     clock[0] = 20.0
     p.update(1)
-    assert p.rate == pytest.approx(20.0)  # one unit: nothing else to go by
+    assert p.rate == pytest.approx(20.0)  # one unit: nothing else to go by ...
+    assert p.left is None and "time left not known yet" in p.line()  # ... so no time left
     for _ in range(10):
         clock[0] += 0.1
         p.update(1)

@@ -69,7 +69,7 @@ def ball_module(fs: FrameworkSystem) -> types.ModuleType:
     if fs.key in _MODULES:
         return _MODULES[fs.key]
     path = cache_root() / "frameworks" / f"system-{fs.key}.json"
-    source = json.loads(path.read_text())["source"]
+    source = fs.source or json.loads(path.read_text())["source"]
     lines = [line for line in source.splitlines() if not line.startswith("from numpy")]
     text = "\n".join(lines).replace("[..., ", "[")
     module = types.ModuleType(f"cotm_framework_balls_{fs.key}")

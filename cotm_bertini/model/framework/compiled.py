@@ -38,6 +38,8 @@ class FrameworkSystem:
     numeric: types.ModuleType  # positions, hessian, constraint_jacobian, first_order (X, P)
     active: tuple[str, ...]  # springs and taut cables, as first_order lists them
     cones: dict[str, ParametricSystem]  # zero-length poses of each spring (two-body torus)
+    source: str = ""  # the generated code, kept: the ball and interval evaluations compile it
+    # from here, not from the disk cache, which may be cleared while this process runs
 
 
 _LOADED: dict[str, FrameworkSystem] = {}
@@ -70,7 +72,7 @@ def framework_system(fw: Framework, taut: tuple[str, ...], label: str = "") -> F
         tuple(derived.kinds), tuple(derived.descriptions), tuple(derived.free),
         tuple(derived.points), derived.local_size, derived.constraints, module,
         tuple(derived.active),
-        {k: ParametricSystem.from_json(v) for k, v in derived.cones.items()},
+        {k: ParametricSystem.from_json(v) for k, v in derived.cones.items()}, derived.source,
     )  # fmt: skip
     _LOADED[key] = out
     return out

@@ -9,9 +9,11 @@ one), and the records are merged into one (boxes.merged).
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 import multiprocessing
+import threading
 import time
 from collections.abc import Callable
 
@@ -93,20 +95,84 @@ def split_search(
         dealt["shares"] = min(shares, len(lo))
         most = None if max_boxes is None else max(1, math.ceil(max_boxes / shares))
         step = dealt["shares"]
-        return [(factory, source, lo[k::step], hi[k::step], short, min_width, most, deadline)
-                for k in range(step)]  # fmt: skip
+        dealt["volumes"] = [float(np.prod(hi[k::step] - lo[k::step], axis=1).sum())
+                            for k in range(step)]  # fmt: skip
+        return [(factory, source, lo[k::step], hi[k::step], short, min_width, most, deadline,
+                 shared, k) for k in range(step)]  # fmt: skip
 
-    finished = as_done(_search_share, jobs, workers, scheduler)  # local processes start now
-    parts: dict[int, BoxSearch] = {}
-    with Progress(label, 1.0, "of the poses decided", heartbeat=True) as report:
-        for k, part in finished:
-            parts[k] = part
-            boxes = dealt["head"].boxes + sum(p.boxes for p in parts.values())
-            decided = 1.0 - dealt["left"] + sum(p.volume for p in parts.values()) / volume
-            report.set(decided, note=f"{boxes:,} boxes, {len(parts)}/{dealt['shares']} shares")
+    with _shares_said(scheduler) as shared:
+        finished = as_done(_search_share, jobs, workers, scheduler)  # local processes start now
+        parts: dict[int, BoxSearch] = {}
+        with Progress(label, 1.0, "of the poses decided", heartbeat=True) as report:
+            with _polled(report, dealt, parts, shared, volume):
+                for k, part in finished:
+                    parts[k] = part
+                    boxes = dealt["head"].boxes + sum(p.boxes for p in parts.values())
+                    report.set(
+                        _decided(dealt, parts, _said(shared), volume),
+                        note=f"{boxes:,} boxes, {len(parts)}/{dealt['shares']} shares",
+                    )
     found = heads + [dealt["head"]] + [parts[k] for k in sorted(parts)]
     _check_cover(label, dealt, parts, volume)
     return merged(found, volume, time.perf_counter() - t0)
+
+
+SHARE_SAID = 1.0  # seconds: a worker says its share's progress at most this often
+
+
+@contextlib.contextmanager
+def _shares_said(scheduler: str | None):
+    """Where local workers say how much of their shares they have decided (a manager's dict,
+    share -> fraction), so that the progress moves before a share comes back; None on a
+    cluster (its shares are said as they come back)."""
+    if scheduler is not None:
+        yield None
+        return
+    manager = multiprocessing.Manager()
+    try:
+        yield manager.dict()
+    finally:
+        manager.shutdown()
+
+
+@contextlib.contextmanager
+def _polled(report: Progress, dealt: dict, parts: dict, shared, volume: float):
+    """The progress set every SHARE_SAID seconds from the workers' fractions of the shares not
+    yet back, in a thread, while the shares run."""
+    if shared is None:
+        yield
+        return
+    stop = threading.Event()
+
+    def poll() -> None:
+        while not stop.wait(SHARE_SAID):
+            report.set(_decided(dealt, parts, _said(shared), volume))
+
+    thread = threading.Thread(target=poll, daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        stop.set()
+        thread.join()
+
+
+def _said(shared) -> dict:
+    """What the workers have said of their shares (share -> fraction decided), or nothing."""
+    if shared is None:
+        return {}
+    try:
+        return dict(shared)
+    except (OSError, EOFError):  # the manager gone: the shares are over
+        return {}
+
+
+def _decided(dealt: dict, parts: dict, said: dict, volume: float) -> float:
+    """The share of the domain decided: the breadth-first steps', the shares back (less what a
+    budget left undecided in them), and the fractions the workers have said of the others."""
+    running = sum(f * dealt["volumes"][k] for k, f in said.items() if k not in parts)
+    back = sum(p.volume * (1.0 - p.undecided_share) for p in parts.values())
+    return 1.0 - dealt["left"] + (back + running) / volume
 
 
 def _check_cover(label: str, dealt: dict, parts: dict, volume: float) -> None:
@@ -135,12 +201,20 @@ def _warm(land: BoxLandscape, first: tuple[np.ndarray, np.ndarray], most: int = 
 def _search_share(job: tuple) -> BoxSearch:
     """One share of boxes searched in a worker: the landscape rebuilt from its source (once a
     process where the factory keeps it), its CPU time counted with the search's."""
-    factory, source, lo, hi, short, min_width, most, deadline = job
+    factory, source, lo, hi, short, min_width, most, deadline, shared, k = job
     c0 = time.process_time()
+    last = [0.0]
+
+    def say(fraction: float) -> None:
+        if shared is not None and time.time() - last[0] >= SHARE_SAID:
+            last[0] = time.time()
+            shared[k] = fraction
+
     with silenced():  # the parent reports the merged progress
         land = factory(source)
         left = None if deadline is None else max(deadline - time.time(), 1e-9)
-        found = search(land, short, min_width, max_boxes=most, max_seconds=left, boxes=(lo, hi))
+        found = search(land, short, min_width, max_boxes=most, max_seconds=left, boxes=(lo, hi),
+                       step=say)  # fmt: skip
     return dataclasses.replace(found, cpu_seconds=time.process_time() - c0)
 
 

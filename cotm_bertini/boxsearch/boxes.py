@@ -36,6 +36,7 @@ from __future__ import annotations
 import contextlib
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Protocol
 
@@ -175,12 +176,15 @@ def search(
     max_seconds: float | None = None,
     label: str = "real search",
     boxes: tuple[np.ndarray, np.ndarray] | None = None,
+    step: Callable[[float], None] | None = None,
 ) -> BoxSearch:
     """Decide every box of the domain (module docstring), or of `boxes` (lo, hi) where given
     (a share of it, for a worker); stop at `max_boxes` or `max_seconds` with the boxes not yet
-    decided listed as undecided."""
+    decided listed as undecided. `step`: told the share of the volume decided after each batch
+    step (a worker's search reports through it)."""
     first = boxes if boxes is not None else domain(land, start)
-    return _search(land, 1, first, short, min_width, max_boxes, max_seconds, label)[0]
+    return _search(land, 1, first, short, min_width, max_boxes, max_seconds, label,
+                   step=step)[0]  # fmt: skip
 
 
 def search_each(
@@ -285,7 +289,7 @@ class _Member:
 
 
 def _search(land, members: int, first: tuple, short, min_width, max_boxes, max_seconds, label,
-            whole: float | None = None):  # fmt: skip
+            whole: float | None = None, step=None):  # fmt: skip
     """The members' searches in lockstep: each step takes every live member's next batch (as
     its own search would) into one call of `_step`, and hands each its rows of the outcome.
     `whole`: the volume of the domain where `first` is only the part left to search."""
@@ -319,6 +323,8 @@ def _search(land, members: int, first: tuple, short, min_width, max_boxes, max_s
             decided -= float(np.prod(b - a, axis=1).sum())
         pending -= decided / volume
         report.set(1.0 - pending / members, note=f"{sum(m.boxes for m in group):,} boxes")
+        if step is not None:
+            step(1.0 - pending / members)
     report.close()
     clocks = ((time.perf_counter() - t0) / members, (time.process_time() - c0) / members)
     return [m.result(n, clocks, whole or volume) for m in group]

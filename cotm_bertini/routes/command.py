@@ -11,6 +11,8 @@ from .result import Timings
 
 
 def paper_command(params: Params, settings: Settings, system, folder: Path, title: str, t: Timings):
+    """The paper's system by the Bertini binary in `folder`: its endpoints and what produced
+    them (Bertini 1's failed paths truncated on their way to infinity not counted lost)."""
     from ..backends.bertini_cli import solve_cli
 
     with t.stage("solve"):

@@ -11,6 +11,8 @@ from .result import STATUS_INCOMPLETE, STATUS_OK, PointSolution, Timings
 
 
 def paper_homotopy(params: Params, settings: Settings, ps, t: Timings, warm) -> tuple:
+    """The paper's system by the parameter homotopy from its generic set (`warm`: a
+    neighbouring point's, to continue from): its endpoints and what produced them."""
     from ..backends.target import solve_target
 
     with t.stage("solve"):
@@ -55,6 +57,7 @@ def solve_taut_set(fw, taut, unit, target, centre, settings, tolerances, t: Timi
 
 
 def bertini_version() -> str:
+    """The bertini module's version."""
     from ..versions import bertini2_version
 
     return bertini2_version()

@@ -192,9 +192,9 @@ def solve_framework_points(
 ) -> list[PointSolution]:
     """solve_framework_point at each of several values of one framework (a sweep's points).
     On the real route their searches run together, in the same batches of boxes
-    (boxsearch.real_route.search_frameworks): each point keeps its own search, box for box
+    (boxsearch.families.search_frameworks): each point keeps its own search, box for box
     the one it would have alone; every point is checked before any is searched."""
-    from .boxsearch.real_route import search_frameworks
+    from .boxsearch.families import search_frameworks
     from .routes.real import real_landscape, solve_real
 
     if not fws or not choose(fws[0], settings).real:

@@ -16,7 +16,7 @@ import tensegrity_physics as tp
 from conftest import ROOT
 
 import cotm_bertini as cb
-from cotm_bertini.boxsearch.real_route import real_equilibria
+from cotm_bertini.boxsearch.families import real_equilibria
 from cotm_bertini.catastrophe.chart_curves import Seed, chart_fold_curves
 from cotm_bertini.catastrophe.curve_trace import Window, newton, tangent, trace
 from cotm_bertini.catastrophe.fold_sweep import curve_equations, long_enough

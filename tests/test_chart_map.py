@@ -115,7 +115,7 @@ def test_prism_map_by_continuation_equals_searches_off_the_anchors():
     every change of the stable count; at grid points that are no anchor, on both sides of it,
     the rows followed equal a proved search of the point (the branch and bound, not the
     continuation)."""
-    from cotm_bertini.boxsearch.real_route import real_equilibria
+    from cotm_bertini.boxsearch.families import real_equilibria
 
     fw = cb.Framework.from_toml(ROOT / "examples" / "prism_slack.toml")
     m = cb.design_map(fw, "L0t", (0.2, 0.8), "h", (1.2, 1.6), points=11, grid="continuation",

@@ -274,7 +274,8 @@ def test_searches_together_equal_each_search_alone():
     units: a number per box kept exact, as one given alone is) and fy = 0 (a continuum of
     equilibria, boxes left undecided)."""
     from cotm_bertini.boxsearch.boxes import MIN_WIDTH, SHORT, search, search_each
-    from cotm_bertini.boxsearch.real_route import TorusFamily, TorusFramework
+    from cotm_bertini.boxsearch.families import TorusFamily
+    from cotm_bertini.boxsearch.real_route import TorusFramework
 
     fw = cb.Framework.from_toml(XMODULE)
     lands = [TorusFramework(fw.replace(L0c=a, fy=b))
@@ -510,7 +511,8 @@ def test_a_family_covered_together_proves_each_point_as_alone():
     from what is left: each point's proved roots equal its own search's (4-link chain, 20
     values of a free length, a cable-free chain where one point would take 125k boxes)."""
     from cotm_bertini.boxsearch.boxes import MIN_WIDTH, SHORT, search
-    from cotm_bertini.boxsearch.real_route import TorusFramework, search_frameworks
+    from cotm_bertini.boxsearch.families import search_frameworks
+    from cotm_bertini.boxsearch.real_route import TorusFramework
 
     fw = cb.Framework.from_toml(ROOT / "tests" / "fixtures" / "chain4.toml")
     fws = [fw.replace(L0=v) for v in np.linspace(1.6, 2.0, 20)]

@@ -271,7 +271,7 @@ def cone_points(fw: Framework, near: np.ndarray | None = None) -> list[dict]:
 def _cones_near(fw: Framework, ps, slots_n: dict, near: np.ndarray) -> np.ndarray:
     """The zero-length poses of one spring (system `ps`) that Newton reaches from the middles of
     the boxes `near` (lo1, lo2, hi1, hi2 rad), each once."""
-    from ..boxsearch.real_route import coarse_pick
+    from ..boxsearch.seeds import coarse_pick
     from ..model.framework.structure import layout
     from .refine import newton_refine
 

@@ -37,15 +37,8 @@ from ..model.framework.units import normalized_slots
 from ..model.intervals import Interval, stack
 from . import rotations
 from .boxes import (
-    MIN_WIDTH,
-    SHORT,
-    BoxSearch,
-    cover,
     distinct,
-    domain,
     initial_boxes,
-    search,
-    search_each,
 )
 from .cones import ConeParts
 from .free_nodes import free_nodes_only, reach
@@ -53,7 +46,6 @@ from .links import (
     EITHER,
     SLACK,
     TAUT,
-    Link,
     add_diagonal,
     columns,
     cone_term,
@@ -162,7 +154,7 @@ class TorusFramework:
         # left undecided, said as such)
         self.cone_sets = self.n >= fw.dim and self.loop is None and not self.spatial
         self.member: np.ndarray | None = None  # a family's view: each box's member (rows)
-        self.family: TorusFamily | None = None
+        self.family = None  # a family's view: its TorusFamily (boxsearch.families)
 
     def renumber(self, slots: dict | None = None) -> None:
         """The numbers taken from normalised `slots` (default: the framework's)."""
@@ -174,7 +166,7 @@ class TorusFramework:
 
     def structure(self) -> tuple:
         """What a search's arithmetic depends on besides the numbers: frameworks of one
-        structure can be searched together (TorusFamily)."""
+        structure can be searched together (boxsearch.families.TorusFamily)."""
         return (self.full.key, tuple((t, fs.key) for t, fs in self.hessian_sets), self.bodies,
                 self.cables, tuple((x.name, x.cable, x.L0 is None) for x in self.links),
                 len(self.P))  # fmt: skip
@@ -566,175 +558,6 @@ class TorusFramework:
         return found_endpoints(fs.ps.variables, values, rows)
 
 
-# A family's boxes no member can have a critical point in are excluded together (its hull,
-# boxes.cover) down to this width, its halves' to half of it, ... down to FAMILY_LEAF members
-# (a 32-point family of chain4: 0.63 s a point, against 1.07 s with no cover; finer covers or
-# smaller leaves cost more than they save).
-COVER_WIDTH = 0.1
-FAMILY_LEAF = 16
-TOGETHER = 32  # frameworks searched in one family (more gain little: 0.010 against 0.011 s)
-
-
-class TorusFamily:
-    """Frameworks of one structure (TorusFramework.structure: the same systems, units and
-    links; other parameter values) as one landscape over boxes that each belong to a member
-    (boxsearch.boxes.search_each): each box's slots, spring stiffnesses and free lengths are
-    its member's, a number where all members share it (so that the arithmetic is the member's
-    own search's), else an array over the boxes."""
-
-    def __init__(self, lands: list[TorusFramework]):
-        self.base, self.members, self.n = lands[0], len(lands), lands[0].n
-        if any(land.structure() != self.base.structure() for land in lands):
-            raise ValueError("a TorusFamily's frameworks must share one structure")
-        self.P = [_shared([land.P[j] for land in lands]) for j in range(len(self.base.P))]
-        self.links = [
-            (_shared([land.links[i].k for land in lands]),
-             _shared([land.links[i].L0 for land in lands]))
-            for i in range(len(self.base.links))
-        ]  # fmt: skip
-
-    def hull(self) -> TorusFramework:
-        """One landscape whose numbers are intervals holding every member's (the slots and
-        the links' k and L0): its enclosures hold each member's, so a box it excludes holds
-        no critical point of any member (boxsearch.boxes.cover)."""
-        view = copy.copy(self.base)
-        view.P = [_interval(v) for v in self.P]
-        view.links = tuple(
-            Link(x.name, _interval(k), None if L0 is None else _interval(L0), x.cable)
-            for x, (k, L0) in zip(self.base.links, self.links, strict=True)
-        )
-        return view
-
-    def rows(self, member: np.ndarray) -> TorusFramework:
-        """The landscape over a batch whose box i belongs to member[i]."""
-        view = copy.copy(self.base)
-        view.P = [v if np.ndim(v) == 0 else v[member] for v in self.P]
-        view.links = tuple(
-            Link(x.name, k if np.ndim(k) == 0 else k[member],
-                 L0 if L0 is None or np.ndim(L0) == 0 else L0[member], x.cable)
-            for x, (k, L0) in zip(self.base.links, self.links, strict=True)
-        )  # fmt: skip
-        view.member, view.family = member, self
-        return view
-
-
-def _interval(v):
-    """A number shared by the members as it is; the members' values as their hull."""
-    return v if np.ndim(v) == 0 else Interval(np.min(v), np.max(v))
-
-
-def _shared(values: list):
-    """The members' values of one number: that number where they all agree, else an array."""
-    if all(v == values[0] for v in values):
-        return values[0]
-    return np.array(values, dtype=float)
-
-
-def search_frameworks(
-    fws: list[Framework],
-    max_seconds: float | None = None,
-    lands: list[TorusFramework] | None = None,
-) -> list[BoxSearch]:
-    """The search (defaults of boxsearch.boxes) of each framework, those of one structure
-    together in batches (TorusFamily, search_each): each the same as its own search."""
-    lands = lands or [landscape(fw) for fw in fws]
-    groups: dict[tuple, list[int]] = {}
-    out: list = [None] * len(lands)
-    for k, land in enumerate(lands):
-        # charts of spheres, and free nodes (each its own bounding cube): a search each
-        if not isinstance(land, TorusFramework) or land.nodes:
-            out[k] = search(land, SHORT, MIN_WIDTH, max_seconds=max_seconds,
-                            label=f"real search of {fws[k].name}")  # fmt: skip
-            continue
-        groups.setdefault(land.structure(), []).append(k)
-    # TOGETHER at most in a family: each step holds up to TOGETHER x BATCH boxes
-    chunks = [ks[i : i + TOGETHER] for ks in groups.values() for i in range(0, len(ks), TOGETHER)]
-    for members in chunks:
-        _search_family(fws, lands, members, max_seconds, out, domain(lands[members[0]], 8))
-    return out
-
-
-def _search_family(fws, lands, members: list[int], max_seconds, out: list, first,
-                   stop: float = COVER_WIDTH, shared: dict | None = None) -> None:  # fmt: skip
-    """search_each of the frameworks `members` (their records into `out`), after what none of
-    them can have a critical point in is excluded once for all (their hull's enclosures:
-    boxes.cover, to `stop` rad); halves of a larger family are covered again from what is
-    left (their hulls are tighter), down to FAMILY_LEAF members. `shared`: each member's share
-    of the boxes covered so far."""
-    family, shared = TorusFamily([lands[k] for k in members]), dict(shared or {})
-    if len(members) > 1:
-        first, looked = cover(family.hull(), first, stop)
-        for k in members:
-            shared[k] = shared.get(k, 0.0) + looked / len(members)
-    if len(members) > FAMILY_LEAF:
-        half = (len(members) + 1) // 2
-        for part in (members[:half], members[half:]):
-            _search_family(fws, lands, part, max_seconds, out, first, stop / 2, shared)
-        return
-    label = f"real search of {fws[members[0]].name}, {len(members)} points"
-    found = search_each(family, SHORT, MIN_WIDTH, max_seconds=max_seconds, label=label,
-                        boxes=first if len(members) > 1 else None)  # fmt: skip
-    for k, f in zip(members, found, strict=True):
-        if shared.get(k):
-            f.notes.append(f"{shared[k]:,.0f} boxes (a share of those searched for its "
-                           "neighbours and it together first)")  # fmt: skip
-        out[k] = f
-
-
-def critical_seeds(land: TorusFramework, boxes: np.ndarray, most: int = 32) -> np.ndarray:
-    """Critical points near undecided or set-aside boxes (lo_1..lo_n, hi_1..hi_n): Newton with
-    a least-squares step (the Hessian may be singular there: a continuum) from the middles of
-    at most `most` of them (`coarse_pick`); the ends where |grad V| < 1e-10. A landscape in
-    charts moves each point to a chart regular there after every step (`rechart`: Newton
-    stays away from a chart's poles, where a component of grad V vanishes by itself)."""
-    n = land.n
-    rechart = getattr(land, "rechart", lambda x: x)
-    if not len(boxes):
-        return np.zeros((0, n))
-    pick = coarse_pick(boxes, most)
-    x = 0.5 * (pick[:, :n] + pick[:, n:])
-    live = np.arange(len(x))
-    for _ in range(30):  # the points still moving only: most converge in a few steps
-        g, h = land.derivatives(x[live])
-        step = np.einsum("nij,nj->ni", np.linalg.pinv(h, rcond=1e-10), g)
-        x[live] = rechart(x[live] - step)
-        live = live[np.isfinite(step).all(axis=1) & (np.abs(step).max(axis=1) > 1e-13)]
-        if not len(live):
-            break
-    g, _ = land.derivatives(x)
-    return x[np.isfinite(g).all(axis=1) & (np.abs(g).max(axis=1) < 1e-10)]
-
-
-def descent_minima(land, starts: int, seed: int, steps: int = 200) -> np.ndarray:
-    """Local minima of V reached from `starts` random points of the domain (seeded): Newton
-    steps where the Hessian is positive definite, else a gradient step of at most 0.2 rad,
-    each shortened until V's first-order decrease is kept (no energy is evaluated: the step
-    is damped instead); the ends with |grad V| < 1e-10 and a positive definite Hessian. Not a
-    proof: evidence, for a search stopped by its budget, that its rows hold every minimum the
-    descents find. None on a loop (its landscape's derivatives are F's, not V's)."""
-    if getattr(land, "loop", None) is not None:
-        return np.zeros((0, land.n))
-    rng = np.random.default_rng(seed)
-    lo, hi = domain(land, 8)
-    pick = rng.integers(0, len(lo), starts)
-    x = lo[pick] + rng.random((starts, land.n)) * (hi[pick] - lo[pick])
-    rechart = getattr(land, "rechart", lambda y: y)
-    for _ in range(steps):
-        g, h = land.derivatives(x)
-        with np.errstate(all="ignore"):
-            eig = np.linalg.eigvalsh(h)
-            newton = np.linalg.solve(np.where((eig > 0).all(axis=1)[:, None, None], h,
-                                              np.eye(land.n)), g[..., None])[..., 0]  # fmt: skip
-        step = np.where((eig > 0).all(axis=1)[:, None], newton, g)
-        step *= np.minimum(1.0, 0.2 / np.maximum(np.abs(step).max(axis=1), 1e-300))[:, None]
-        x = rechart(x - step)
-        if np.abs(step).max(initial=0.0) < 1e-15:  # every descent has arrived (or is stuck)
-            break
-    g, h = land.derivatives(x)
-    good = (np.abs(g).max(axis=1) < 1e-10) & (np.linalg.eigvalsh(h) > 0).all(axis=1)
-    return x[good]
-
-
 def _chart_hessian(frames: list, Ds: list, g: list, hess) -> Interval | np.ndarray:
     """Hess_u V = D Hess_v V D^T + sum_a g_a W_a (boxsearch.rotations; D block diagonal, a block
     per body), from Hess_v V (`hess`: (B, n, n) Interval or (R, n, n) array) and grad_v V's
@@ -779,44 +602,3 @@ def fresh_points(points: np.ndarray, known: np.ndarray, apart: float = 1e-8,
     both = np.vstack([known.reshape(-1, n), points.reshape(-1, n)])
     keep = distinct(both, apart, wrap)
     return both[keep[keep >= len(known)]]
-
-
-KEEP = 128  # real_equilibria keeps the last this many frameworks' equilibria
-_KEPT: dict[Framework, tuple] = {}
-
-
-def real_equilibria(fw: Framework) -> tuple[dict[tuple[str, ...], Endpoints], BoxSearch]:
-    """Every real critical point of V (the search's default settings), as endpoints by taut set
-    (keys sorted, as FrameworkSystem.taut), with the search's record; kept for the last
-    frameworks asked for, since fold seeds of every curve system share their crossings."""
-    return real_equilibria_of([fw])[0]
-
-
-def real_equilibria_of(fws: list[Framework]) -> list[tuple]:
-    """real_equilibria of each framework; those not kept are searched together
-    (search_frameworks: each its own search, in shared batches of boxes)."""
-    todo = [fw for fw in dict.fromkeys(fws) if fw not in _KEPT]
-    made = {}
-    if todo:
-        lands = [landscape(fw) for fw in todo]
-        for fw, land, found in zip(todo, lands, search_frameworks(todo, lands=lands),
-                                   strict=True):  # fmt: skip
-            groups = land.endpoints(found.roots).items()
-            made[fw] = {tuple(sorted(k)): v for k, v in groups}, found
-    out = [made[fw] if fw in made else _KEPT[fw] for fw in fws]
-    _KEPT.update(made)
-    for fw in list(_KEPT)[: max(0, len(_KEPT) - KEEP)]:
-        del _KEPT[fw]
-    return out
-
-
-def coarse_pick(boxes: np.ndarray, most: int, cell: float = 0.02) -> np.ndarray:
-    """At most `most` of the boxes (lo_1..lo_n, hi_1..hi_n), one a cell of `cell` rad of their
-    middles, spread over the list: every cluster of boxes (one around each cone point or along
-    a continuum) is seeded, not just the largest."""
-    n = boxes.shape[1] // 2
-    mid = 0.5 * (boxes[:, :n] + boxes[:, n:])
-    _, first = np.unique(np.floor(mid / cell).astype(np.int64), axis=0, return_index=True)
-    first = np.sort(first)
-    return boxes[first[np.unique(np.linspace(0, len(first) - 1, min(most, len(first)))
-                                 .astype(int))]]  # fmt: skip

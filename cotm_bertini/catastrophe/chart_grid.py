@@ -286,7 +286,8 @@ def anchor_task(task: tuple) -> dict:
     boxes left undecided) and what the search decided."""
     from ..boxsearch.box_shares import split_search
     from ..boxsearch.boxes import MIN_WIDTH, SHORT
-    from ..boxsearch.real_route import critical_seeds, landscape
+    from ..boxsearch.real_route import landscape
+    from ..boxsearch.seeds import critical_seeds
 
     fw, key, seconds = task
     t0 = time.perf_counter()

@@ -66,10 +66,10 @@ def sweep_seeds(
     tasks = [(fw, cs, spec, ts, names, settings) for spec in vertical]
     stage = f"{what}: equilibria at {len(vertical)} x {len(ts)} crossings, by vertical line"
     # On the real route a crossing's search serves every curve system of the map (kept in this
-    # process, real_route.real_equilibria): searched here, once, not in a worker each time.
+    # process, families.real_equilibria): searched here, once, not in a worker each time.
     real = choose(fw, settings).real
     if real:  # all crossings searched together, in shared batches of boxes
-        from ..boxsearch.real_route import real_equilibria_of
+        from ..boxsearch.families import real_equilibria_of
 
         real_equilibria_of([_crossing(fw, cs, names, spec, t) for spec in vertical for t in ts])
     for part in run_reported(_here if real else run, _solve_line, tasks, stage, "lines", batch):
@@ -162,7 +162,7 @@ def _real_line(task) -> dict:
     """`_solve_line` by the real route: each crossing's real equilibria of the taut set (those
     consistent with its cable states: a branch that becomes consistent between two crossings
     enters through a cable switch), no path lost, and the boxes its search left undecided."""
-    from ..boxsearch.real_route import real_equilibria
+    from ..boxsearch.families import real_equilibria
 
     fw, cs, spec, ts, names, _ = task
     out = {}

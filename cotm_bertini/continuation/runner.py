@@ -75,7 +75,7 @@ def solve_run(
     """
     settings = point_settings(spec)
     if _searched_together(spec, indices, settings):
-        from ..boxsearch.real_route import TOGETHER
+        from ..boxsearch.families import TOGETHER
         from ..point import solve_framework_points
 
         for at in range(0, len(indices), TOGETHER):
@@ -98,7 +98,7 @@ def solve_run(
 
 def _searched_together(spec: SweepSpec, indices: list[int], settings: Settings) -> bool:
     """Whether the points are a framework's on the real route: their searches then run
-    together, real_route.TOGETHER at a time (point.solve_framework_points: the batches of boxes,
+    together, families.TOGETHER at a time (point.solve_framework_points: the batches of boxes,
     not Python's steps, set the pace; each point's search and rows as if solved alone)."""
     if spec.framework is None or not indices:
         return False

@@ -139,7 +139,7 @@ def _minima_only(land, found, seeds: np.ndarray, descents: dict, seed: int | Non
     with a warning), the seeds Newton found (not proved) kept where their Hessian is positive
     definite."""
     from ..boxsearch.minima import proved_minima
-    from ..boxsearch.real_route import descent_minima
+    from ..boxsearch.seeds import descent_minima
 
     verdict = proved_minima(land, found.roots)
     keep = verdict >= 0
@@ -183,7 +183,7 @@ def _unproved(land, found, unit: tuple[float, float], seed: int | None) -> tuple
     left undecided (a continuum passes there) or set aside next to a cone point, found by
     Newton (not proved unique; a search stopped by its budget leaves much undecided: more
     seeds, more rows found) and by descents; the free regions, whose points are not rows."""
-    from ..boxsearch.real_route import critical_seeds
+    from ..boxsearch.seeds import critical_seeds
 
     most = SEEDS_AT_BUDGET if found.budget_hit else 32
     seeds = land.fresh(np.vstack([critical_seeds(land, found.undecided, most),
@@ -199,7 +199,7 @@ def _descents(land, found, seeds, seed: int | None) -> dict:
     """Evidence for a search stopped by its budget (none otherwise): local descents from
     DESCENTS random poses, the minima they reach, and how many of those the search or Newton
     had already found (the others join the rows)."""
-    from ..boxsearch.real_route import descent_minima
+    from ..boxsearch.seeds import descent_minima
 
     if not found.budget_hit:
         return {"starts": 0, "points": np.zeros((0, land.n))}

@@ -218,7 +218,7 @@ def test_workers_write_the_lines_pandas_would(tmp_path):
     structures: here both free lengths reach 0) equal those written afterwards from the stored
     points, which equal pandas' own."""
     import cotm_bertini as cb
-    from cotm_bertini.continuation.results import finish
+    from cotm_bertini.continuation.results import finish_columns
     from cotm_bertini.continuation.runner import assemble, sweep_names
     from cotm_bertini.continuation.store import PointStore
     from cotm_bertini.continuation.tables import union_names
@@ -228,6 +228,6 @@ def test_workers_write_the_lines_pandas_would(tmp_path):
     store = PointStore(sw.folder)
     assert sweep_names(sw.spec) == union_names([store.points[i] for i in range(4)])
     by_workers = (sw.folder / "sweep.csv").read_text()
-    finish(sw.spec, sw.folder, sw.record["stats"])  # again, from the file: no worker lines
+    finish_columns(sw.spec, sw.folder, sw.record["stats"])  # again, from the file: no worker lines
     assert (sw.folder / "sweep.csv").read_text() == by_workers
     assert by_workers == assemble(sw.spec, sw.folder).to_csv(index=False)

@@ -22,21 +22,6 @@ from .store import PointStore
 from .tables import Columns, csv_text, rows_text, union_names
 
 
-def finish(
-    spec: SweepSpec,
-    folder: Path,
-    stats: dict,
-    workers: int = 1,
-    scheduler: str | None = None,
-    command: list[str] | None = None,
-    store: PointStore | None = None,
-) -> dict:
-    """Assemble sweep.csv (with branches for 1-D sweeps), events.csv and run.json; returns the
-    run record. `store`: the folder's points, already in memory (default: read from disk)."""
-    record, _ = finish_columns(spec, folder, stats, workers, scheduler, command, store)
-    return record
-
-
 def finish_columns(
     spec: SweepSpec,
     folder: Path,
@@ -46,7 +31,9 @@ def finish_columns(
     command: list[str] | None = None,
     store: PointStore | None = None,
 ) -> tuple[dict, Columns]:
-    """`finish`, returning (the run record, the table as numpy columns, branch included)."""
+    """Assemble sweep.csv (with branches for 1-D sweeps), events.csv and run.json: (the run
+    record, the table as numpy columns, branch included). `store`: the folder's points, already
+    in memory (default: read from disk)."""
     from ..params import Params
     from .events import event_columns, event_records
     from .matching import branch_ids

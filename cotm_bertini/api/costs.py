@@ -67,7 +67,7 @@ class Cost:
     derive_seconds: float  # spent deriving equations to count the paths (cached from now on)
     route: str = "total-degree"  # of the generic sets (backends.generic.route_of); "both":
     # `sets` count the total-degree set of the seed, the monodromy one is not counted
-    pruned: int = 0  # taut sets no pose can hold (point.pruned_taut_sets): not in `sets`
+    pruned: int = 0  # taut sets no pose can hold (model.framework.taut_sets): not in `sets`
     search: dict | None = None  # the real route's sample search (_search_sample), if run
     why: str = ""  # why the route was chosen (routes.choose)
 

@@ -123,7 +123,7 @@ class SphereFramework:
         self.parent = {n: top for n, top, _ in chain}
         self.renumber()
         self.n = 2 * len(self.nodes)
-        self.bodies = ()  # no body angles (point.along_continua)
+        self.bodies = ()  # no body angles (routes.real.along_continua)
         names = list(self.full.ps.variables)
         self.coords = [names.index(f"n_{v}_{c}") for v in self.nodes for c in "xyz"]
         # The generated code's local coordinates are the nodes' coordinates, in this order.

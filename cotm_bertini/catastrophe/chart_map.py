@@ -86,7 +86,7 @@ def _not_proved(points: int, proved: int) -> str:
 
 def _grid_rows(fw: Framework, plane: ChartPlane, x: str, xs, y: str, ys, known: dict,
                settings: Settings) -> tuple[pd.DataFrame, list]:  # fmt: skip
-    """Each grid point's rows, classified as a solve's (point.real_table), with its index and
+    """Each grid point's rows, classified as a solve's (routes.real.real_table), with its index and
     the swept values; and the grid points whose Morse sum fails."""
     from ..analysis.framework_checks import morse_count
     from ..routes.real import real_table

@@ -171,7 +171,7 @@ def _curve_systems(fw: Framework, centre: Framework, window: tuple, kinds) -> li
 def _window_taut_sets(fw: Framework, xname: str, xrange, yname: str, yrange) -> list[tuple]:
     """The taut sets that can occur somewhere in the window: those of any of TAUT_GRID x
     TAUT_GRID points of it (corners included; a cable always taut at the centre may go slack
-    near an edge), all taut first as point.taut_sets orders them."""
+    near an edge), all taut first as model.framework.taut_sets orders them."""
     from ..model.framework.taut_sets import taut_sets
 
     found: set[tuple[str, ...]] = set()

@@ -19,7 +19,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ..backends.pools import as_done, default_workers
+from ..backends.pools import as_done, default_workers, start_method
 from ..errors import SolverError
 from ..model.intervals import Interval
 from ..progress import Progress, silenced
@@ -128,7 +128,9 @@ def _shares_said(scheduler: str | None):
     if scheduler is not None:
         yield None
         return
-    manager = multiprocessing.Manager()
+    # started as the pool's workers are (pools.start_method: no fork once the bertini module
+    # runs threads in this process)
+    manager = multiprocessing.get_context(start_method()).Manager()
     try:
         yield manager.dict()
     finally:

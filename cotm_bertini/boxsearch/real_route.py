@@ -263,7 +263,7 @@ class TorusFramework:
         loop's F in place of grad V (boxsearch.loops)."""
         lengths, grad, states = self.enclose_v(box)
         if self.spatial:
-            grad = self._centred(box, self.to_chart(self.frames(box), grad)[0], states)
+            grad = self._centred(box, grad, states)
         if self.loop is not None:
             X = self.pose(self.full, self.trig(box))
             grad = self.loop.enclose(ball_module(self.full), X, self.P, grad)
@@ -290,11 +290,12 @@ class TorusFramework:
             Interval(np.zeros(shape + (0,))))  # fmt: skip
         return lengths, stack(grad, axis=1), states
 
-    def _centred(self, box: Interval, grad: Interval, states: dict) -> Interval:
-        """grad V in chart coordinates met with its mean-value form g(mid) + H(box) (box - mid)
-        on the boxes no wider than CENTRED where it may vanish: the generated code's natural
-        enclosure of a turning body's gradient is some 15 w wide on a box of width w, about
-        five times the mean-value form's."""
+    def _centred(self, box: Interval, grad_v: Interval, states: dict) -> Interval:
+        """grad V in chart coordinates (from `grad_v`, in the generated code's coordinates) met
+        with its mean-value form g(mid) + H(box) (box - mid) on the boxes no wider than CENTRED
+        where it may vanish: the generated code's natural enclosure of a turning body's gradient
+        is some 15 w wide on a box of width w, about five times the mean-value form's."""
+        grad = self.to_chart(self.frames(box), grad_v)[0]
         rows = np.flatnonzero(grad.contains_zero().all(axis=1)
                               & ((box.hi - box.lo).max(axis=1) <= CENTRED))  # fmt: skip
         if not len(rows):
@@ -302,7 +303,8 @@ class TorusFramework:
         sub, mid, land = box[rows], box.mid[rows], self.sub(rows)  # (a family's: its members')
         _, at, _ = land.enclose_v(Interval(mid))
         at = land.to_chart(land.frames(Interval(mid)), at)[0]
-        H = land.hessian(sub, {c: v[rows] for c, v in states.items()})
+        hess_v = land.hessian_v(sub, {c: v[rows] for c, v in states.items()})
+        H = land.to_chart(land.frames(sub), grad_v[rows], hess_v)[1]  # grad_v: known, not again
         dev = sub - mid
         mv = stack([interval_sum([at[:, i]] + [H[:, i, j] * dev[:, j] for j in range(self.n)])
                     for i in range(self.n)], axis=1)  # fmt: skip
@@ -481,9 +483,9 @@ class TorusFramework:
         Ds = [rotations.jacobian(f) for f in frames]
         g = [grad[:, i] for i in range(self.n)]
         out = [c for j, (f, D) in enumerate(zip(frames, Ds, strict=True))
-               for c in rotations.gradient(f, D, g[3 * j : 3 * j + 3])]  # fmt: skip
+               for c in rotations.gradient(D, g[3 * j : 3 * j + 3])]  # fmt: skip
         if hess is not None:
-            hess = _chart_hessian(frames, Ds, g, hess)
+            hess = _chart_hessian(frames, Ds, out, hess)
         return (stack(out, axis=1) if isinstance(grad, Interval) else np.stack(out, axis=1)), hess
 
     def chart_points(self, cols: dict) -> np.ndarray:
@@ -560,8 +562,8 @@ class TorusFramework:
 
 def _chart_hessian(frames: list, Ds: list, g: list, hess) -> Interval | np.ndarray:
     """Hess_u V = D Hess_v V D^T + sum_a g_a W_a (boxsearch.rotations; D block diagonal, a block
-    per body), from Hess_v V (`hess`: (B, n, n) Interval or (R, n, n) array) and grad_v V's
-    columns `g`."""
+    per body), from Hess_v V (`hess`: (B, n, n) Interval or (R, n, n) array) and the chart
+    gradient's columns `g` (D grad_v V)."""
     n, boxes = len(g), isinstance(hess, Interval)
     add = interval_sum if boxes else sum
     rows: list[list] = [[None] * n for _ in range(n)]
@@ -573,7 +575,7 @@ def _chart_hessian(frames: list, Ds: list, g: list, hess) -> Interval | np.ndarr
             for p in range(3):
                 for r in range(3):
                     rows[3 * j + p][3 * k + r] = add(left[p][b] * Dk[r][b] for b in range(3))
-        bend = rotations.curvature(frames[j], Dj, g[3 * j : 3 * j + 3])
+        bend = rotations.curvature(frames[j], g[3 * j : 3 * j + 3])
         for p in range(3):
             for r in range(3):
                 rows[3 * j + p][3 * j + r] = rows[3 * j + p][3 * j + r] + bend[p][r]

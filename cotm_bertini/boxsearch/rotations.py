@@ -133,15 +133,15 @@ def jacobian(f: dict) -> list:
     return rows
 
 
-def gradient(f: dict, D: list, g: list) -> list:
+def gradient(D: list, g: list) -> list:
     """grad_u V = D grad_v V of one body (`g`: its three grad_v components)."""
     return [D[j][0] * g[0] + D[j][1] * g[1] + D[j][2] * g[2] for j in range(3)]
 
 
-def curvature(f: dict, D: list, g: list) -> list:
-    """sum_a g_a W_a (3 x 3 nested lists): the chart's own term of Hess_u V."""
+def curvature(f: dict, Dg: list) -> list:
+    """sum_a g_a W_a (3 x 3 nested lists): the chart's own term of Hess_u V, from the body's
+    chart gradient Dg = D grad_v V (`gradient`; W_jk = -(u_j D_k + u_k D_j) / |n|^2)."""
     u, inv2 = f["u"], f["inv2"]
-    Dg = gradient(f, D, g)  # D_k . g
     return [[-(u[j] * Dg[k] + u[k] * Dg[j]) * inv2 for k in range(3)] for j in range(3)]
 
 
